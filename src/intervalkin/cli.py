@@ -1,0 +1,115 @@
+"""The ``intervalkin`` command: a thin layer over the library.
+
+Exit status: 0 on success, 2 on bad input (one line on stderr, no traceback),
+1 on an internal failure.  Each sub-command has one ``_cmd_*`` function that
+parses nothing itself: argparse validates the shapes, the library validates the
+values and raises :class:`~intervalkin.errors.IntervalkinError` subclasses.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Callable, Sequence
+
+from .errors import IntervalkinError
+
+__all__ = ["main", "build_parser"]
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors and exit status 2."""
+
+    def error(self, message: str):  # type: ignore[override]
+        sys.stderr.write(f"intervalkin: error: {message}\n")
+        sys.exit(2)
+
+
+def _print_json(obj) -> None:
+    sys.stdout.write(json.dumps(obj, indent=None) + "\n")
+
+
+# --------------------------------------------------------------------------------------
+# Sub-commands
+# --------------------------------------------------------------------------------------
+def _cmd_dkp(args: argparse.Namespace) -> int:
+    from .dkp import format_dkp_table, parse_joint_vector, solve
+    from .geometry import geometry_from_option
+
+    geometry = geometry_from_option(args.geometry)
+    rho = parse_joint_vector(geometry, args.rho)
+    result = solve(geometry, rho)
+    if args.json:
+        _print_json(result.to_json())
+    else:
+        sys.stdout.write(format_dkp_table(result) + "\n")
+    return 0
+
+
+def _cmd_table1(args: argparse.Namespace) -> int:
+    from .paper import format_table1, table1_comparison
+
+    comparison = table1_comparison()
+    if args.json:
+        _print_json(comparison.to_json())
+    else:
+        sys.stdout.write(format_table1(comparison) + "\n")
+    return 0
+
+
+def _cmd_pave(args: argparse.Namespace) -> int:
+    from .analysis import run_pave
+
+    return run_pave(geometry_path=args.geometry, depth=args.depth, out=args.out)
+
+
+_COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
+    "dkp": _cmd_dkp,
+    "table1": _cmd_table1,
+    "pave": _cmd_pave,
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="intervalkin",
+        description="Certified definition sets of the planar 3-RPR parallel manipulator (Wenger & Chablat 1997).",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser("dkp", help="certified direct kinematics: every assembly mode of a joint vector")
+    p.add_argument("rho", nargs=3, metavar=("R1", "R2", "R3"), help="leg lengths (exact decimals)")
+    p.add_argument("--geometry", metavar="FILE", help="geometry TOML file (default: the paper's manipulator)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("table1", help="the paper's Table 1 beside the certified solutions")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("pave", help="certified pavings of the workspace, singular surface and aspects")
+    p.add_argument("--geometry", metavar="FILE")
+    p.add_argument("--depth", type=int, default=6, metavar="N", help="octree depth (default 6)")
+    p.add_argument("--out", default="intervalkin-pave", metavar="DIR", help="output folder")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return _COMMANDS[args.command](args)
+    except IntervalkinError as exc:
+        sys.stderr.write(f"intervalkin: error: {exc}\n")
+        return 2
+    except KeyboardInterrupt:
+        sys.stderr.write("intervalkin: interrupted\n")
+        return 130
+    except BrokenPipeError:
+        return 0
+    except Exception as exc:  # an internal failure: one line, status 1
+        sys.stderr.write(f"intervalkin: internal error: {type(exc).__name__}: {exc}\n")
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
