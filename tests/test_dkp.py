@@ -313,6 +313,8 @@ def test_solution_exactly_at_phi_pi():
     assert np.allclose(approx_inverse_kinematics(g, np.array([1.0, 2.0, math.pi])), [15, 15, 17])
     result = solve(g, [Fraction(15), Fraction(15), Fraction(17)])
     assert result.complete, result.completeness_reason
+    # f(pi) = 0 exactly: the substitution must have been shifted off phi0 = 0
+    assert "tan((phi - 0)/2)" not in result.completeness_reason
     check_certified(g, result)
     assert result.count == len(approx_solve(g, [15, 15, 17]))
     seam = [s for s in result.solutions if abs(s.midpoint[2] - math.pi) < 1e-9]

@@ -443,9 +443,8 @@ def _krawczyk(geometry: Geometry, rho_sq, start: np.ndarray, prec: int):
     scale = 1.0 + float(np.max(np.abs(mf)))
     r0 = max(1e3 * size, scale * 2.0 ** (-prec + 24))
     reason = "Krawczyk image not inside the box (Jacobian singular or nearly singular on the box)"
-    for r in (r0, r0 * 1e2, r0 * 1e4, 2e-10):
-        if r > 2e-10:
-            break
+    radii = sorted({min(r, 2e-10) for r in (r0, r0 * 1e2, r0 * 1e4)})
+    for r in radii:
         X = [mi + arb(0, r) for mi in m]
         JX = jacobian_arb(geometry, X[0], X[1], X[2])
         K = []
@@ -523,6 +522,9 @@ def _attempt(geometry: Geometry, rho, rho_sq, prec: int) -> _Attempt:
                         "(it may vanish identically: architecturally singular manipulator)", [])
     phi0, _lead = shift
     coeffs = _poly_t(red, phi0)
+    if coeffs[6].contains(0):  # the leading coefficient is f(phi0 + pi): must be proved non-zero
+        return _Attempt([], False, f"leading coefficient of the reduced sextic not proved non-zero at {prec} bits",
+                        _float_candidates(coeffs, phi0, red))
     try:
         roots = acb_poly(coeffs).roots(maxprec=2 * prec)
     except ValueError:
