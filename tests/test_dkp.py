@@ -480,3 +480,18 @@ def test_cli_dkp_bad_geometry(capsys, tmp_path):
     assert err.count("\n") == 1 and "Traceback" not in err
     assert main(["dkp", "15", "15", "15", "--geometry", str(tmp_path / "missing.toml")]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_box_separation_reads_phi_modulo_two_pi():
+    from intervalkin.dkp import _disjoint
+
+    def box(x, y, phi, r=1e-12):
+        return np.array([[x - r, x + r], [y - r, y + r], [phi - r, phi + r]])
+
+    assert _disjoint(box(1, 2, 0.5), box(1.1, 2, 0.5))  # apart in x
+    assert _disjoint(box(1, 2, 0.5), box(1, 2, 0.5 + 1e-9))  # apart in phi
+    assert not _disjoint(box(1, 2, 0.5), box(1, 2, 0.5 + 1e-12))  # overlapping
+    # the same pose written at +pi and at -pi: the same point of the circle
+    assert not _disjoint(box(1, 2, math.pi), box(1, 2, -math.pi))
+    assert not _disjoint(box(1, 2, 0.25), box(1, 2, 0.25 + 2 * math.pi, r=1e-11))
+    assert _disjoint(box(1, 2, math.pi - 1e-6), box(1, 2, -math.pi + 1e-6))

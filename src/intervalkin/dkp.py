@@ -636,6 +636,14 @@ def solve(geometry: Geometry, rho: Sequence[Fraction]) -> DkpResult:
         excluded).  Precision is raised 64 -> 128 -> 256 -> 512 bits; past the
         ceiling the result has ``complete`` False, a reason, the unique boxes that
         could still be proved and ``"unknown"`` entries for the rest.
+
+    Examples
+    --------
+    >>> from intervalkin.geometry import default_geometry
+    >>> g = default_geometry()
+    >>> r = solve(g, parse_joint_vector(g, ["14.98", "15.38", "12.0"]))
+    >>> r.count, r.complete, [s.aspect for s in r.solutions]
+    (6, True, ['WA2', 'WA1', 'WA1', 'WA2', 'WA2', 'WA1'])
     """
     from flint import arb, ctx, fmpq
 
