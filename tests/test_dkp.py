@@ -171,8 +171,8 @@ def test_certified_boxes_hold_high_precision_roots(paper_geometry, geometry_file
 
 @settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.tuples(*[st.integers(min_value=1000, max_value=3200)] * 3))
-def test_solutions_of_poses_are_found(paper_geometry, centi):
-    """q = g(X) for a pose drawn by hypothesis (rounded): a certified box lies near X."""
+def test_random_centi_vectors_solutions_satisfy_equations(paper_geometry, centi):
+    """Joint vectors drawn by hypothesis: each certified midpoint maps back onto rho."""
     rho = [Fraction(c, 100) for c in centi]
     result = solve(paper_geometry, rho)
     if not result.complete:  # allowed, but then it must say why
