@@ -1,0 +1,614 @@
+"""Characteristic surfaces, basic regions, basic components and uniqueness domains.
+
+The paper's sections 4 and 5 (Definitions 2-4, Proposition 1, Theorems 1-2),
+rebuilt on certified pavings.
+
+* Characteristic surface S_c(WA) = {X in WA : g(X) in g(S)} (the joint-limit part
+  of the aspect's boundary maps onto the boundary of the joint box).  A box of an
+  aspect is *certified off S_c* when its interval image g(b) meets no marked
+  voxel of the joint-space enclosure of g(S) (:mod:`intervalkin.joint`); the
+  boxes of the aspect that are not so certified form an outer enclosure of S_c.
+* Basic regions (Definition 3): connected components of WA minus S_c.  Here:
+  face-connected components (phi seam included) of the boxes certified inside an
+  aspect and off S_c.  Each is connected (union of adjacent closed boxes) and
+  lies in ONE true basic region (it is connected and avoids S_c).
+* Basic component (Definition 4): g of a basic region.  Every box of a region
+  maps into unmarked voxels of one joint cell (its index range is a block of
+  unmarked voxels); adjacent boxes share a face, so a whole region maps into
+  one cell, which the code checks.
+* Distinctness (DESIGN.md section 6): two regions are certified different when
+  (a) their aspects differ (opposite certified det A signs); (b) their cells have
+  different certified counts (different basic components); or (c) a joint
+  vector q has two certified solutions of the same aspect, one in a box of each
+  region: by Theorem 1, g is injective on a basic region, so the two regions lie
+  in different basic regions.  The certified lower bound on the number of basic
+  regions is the size of a largest set of pairwise certified-distinct regions.
+* Proposition 1 check: above each cell C and for each aspect, the number of
+  regions found should equal the certified number of solutions of that aspect
+  in C; every mismatch is reported (a region split by the undecided layer, or
+  one not resolved at this depth).
+* Uniqueness domains (Theorem 2): each aspect's regions are partitioned into the
+  fewest groups that are connected in the region adjacency graph and hold at
+  most one region above each cell.  The number is minimal because the regions
+  above one cell must all be in different groups: it cannot be smaller than the
+  largest number of solutions of one aspect over the cells.
+
+What is not certified, and said so in the results: that two cells of equal
+count are different true cells (so regions above them may be parts of one true
+basic region), hence the found number of regions is exact only when the
+consistency checks pass AND the lower bound equals it; and the adjacency of
+regions across the undecided layer (a heuristic: the layer is split between
+the regions by nearest-region growth).
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Callable, Sequence
+
+import numpy as np
+
+from .geometry import Geometry
+from .joint import JointPaving, singular_image
+from .paving import Label, Paving, component_labels, pave_multi, shares_face, workspace_paving_domain
+from .predicates import aspect_labels, det_sign_predicate, workspace_predicate
+
+__all__ = [
+    "region_adjacency",
+    "uniqueness_domains",
+    "BasicRegion",
+    "Witness",
+    "RegionAnalysis",
+    "off_characteristic_predicate",
+    "pave_regions",
+    "analyse_regions",
+    "label_pose",
+]
+
+ASPECTS = ("WA1", "WA2")
+
+
+def off_characteristic_predicate(geometry: Geometry, joint: JointPaving) -> Callable[[np.ndarray], np.ndarray]:
+    """Tri-state label "certified off the characteristic surfaces".
+
+    INSIDE where the interval image g(b) meets no marked voxel (so g(b) misses g(S));
+    never OUTSIDE (no box is proved to lie wholly on S_c); BOUNDARY otherwise.
+    """
+
+    def predicate(boxes: np.ndarray) -> np.ndarray:
+        lo, hi = singular_image(geometry, boxes)
+        meets = joint.meets_marked(lo, hi)
+        return np.where(meets, Label.BOUNDARY, Label.INSIDE).astype(np.uint8)
+
+    return predicate
+
+
+def pave_regions(geometry: Geometry, joint: JointPaving, depth: int, progress=None) -> Paving:
+    """Pave W, det A, the aspects and "off S_c" in one pass (labels W, det_positive, WA1, WA2, off_Sc).
+
+    A box is split while W is undecided, while it is in W with an undecided det A
+    sign, or while it is inside an aspect but not certified off S_c.
+    """
+    def split(labels):
+        w, d, c = labels["W"], labels["det_positive"], labels["off_Sc"]
+        in_aspect = (w == Label.INSIDE) & (d != Label.BOUNDARY)
+        return (w == Label.BOUNDARY) | ((w == Label.INSIDE) & (d == Label.BOUNDARY)) | (in_aspect & (c == Label.BOUNDARY))
+
+    p = pave_multi(
+        workspace_paving_domain(geometry),
+        [
+            ("W", workspace_predicate(geometry)),
+            ("det_positive", det_sign_predicate(geometry)),
+            ("off_Sc", off_characteristic_predicate(geometry, joint)),
+        ],
+        depth,
+        split=split,
+        relevant={
+            "det_positive": lambda labels: labels["W"] != Label.OUTSIDE,
+            "off_Sc": lambda labels: (labels["W"] == Label.INSIDE) & (labels["det_positive"] != Label.BOUNDARY),
+        },
+        progress=progress,
+    )
+    p.labels["WA1"], p.labels["WA2"] = aspect_labels(p.labels["W"], p.labels["det_positive"])
+    return p
+
+
+@dataclass(frozen=True)
+class BasicRegion:
+    """A basic region: one sheet of g^{-1}(C) in one aspect above a joint cell C.
+
+    ``n_boxes`` / ``volume`` are those of the certified boxes assigned to it
+    (possibly 0 when all its boxes are still in the undecided layer).
+    ``pieces`` is the number of face-connected pieces of boxes assigned to it.
+    """
+
+    id: int
+    aspect: str
+    cell: int
+    sheet: int
+    cell_count: int
+    n_boxes: int
+    volume: float
+    pieces: int
+
+    def to_json(self) -> dict:
+        return {"id": self.id, "aspect": self.aspect, "cell": self.cell, "sheet": self.sheet,
+                "cell_count": self.cell_count, "boxes": self.n_boxes, "volume": self.volume, "pieces": self.pieces}
+
+
+@dataclass(frozen=True)
+class Witness:
+    """A joint vector with certified solutions of one aspect, each inside a box of a piece.
+
+    ``pieces[k]`` is the piece whose box contains ``boxes[k]``; the solutions are
+    distinct, so by Theorem 1 the pieces lie in pairwise different basic regions.
+    """
+
+    rho: tuple[Fraction, Fraction, Fraction]
+    cell: int
+    aspect: str
+    pieces: tuple[int, ...]
+    boxes: tuple[tuple[tuple[float, float], ...], ...]
+
+    def to_json(self) -> dict:
+        return {
+            "rho": [f"{v.numerator}/{v.denominator}" for v in self.rho],
+            "cell": self.cell,
+            "aspect": self.aspect,
+            "pieces": list(self.pieces),
+            "solution_boxes": [[list(iv) for iv in b] for b in self.boxes],
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class RegionAnalysis:
+    """Everything sections 4-5 of the paper define, on one paving.
+
+    Per box (arrays of shape (n,), -1 for none): ``aspect`` (aspect component),
+    ``piece`` (face-connected piece of certified boxes off S_c), ``region`` (basic
+    region id, -1 where the sheet is undecided), ``domain`` (uniqueness domain).
+    """
+
+    paving: Paving
+    edges: np.ndarray
+    aspect: np.ndarray
+    piece: np.ndarray
+    piece_cell: np.ndarray
+    region: np.ndarray
+    domain: np.ndarray
+    regions: tuple[BasicRegion, ...]
+    witnesses: tuple[Witness, ...]
+    lower_bound: int
+    consistency: tuple[dict, ...]
+    unrealized_cells: tuple[int, ...]
+    domains: tuple[tuple[int, ...], ...]
+    domains_lower_bound: int
+    aspect_info: tuple[dict, ...]
+    seconds: float
+
+    @property
+    def consistent(self) -> bool:
+        return all(c["sheets_with_boxes"] == c["expected"] and c["unassigned_pieces"] == 0 for c in self.consistency)
+
+    def counts(self) -> dict:
+        """The counts with their certification status (the summary.json schema)."""
+        per_sign = {a: sum(1 for i in self.aspect_info if i["aspect"] == a) for a in ASPECTS}
+        n_aspects = sum(1 for a in ASPECTS if per_sign[a] > 0)
+        n_regions = len(self.regions)
+        return {
+            "aspects": {
+                "count": n_aspects,
+                "exact": False,
+                "lower_bound": n_aspects,
+                "components_per_sign": per_sign,
+                "why": "opposite certified signs of det A witness two different aspects (the lower bound); "
+                       "each sign's INSIDE boxes form the components listed; a piece of an aspect lying wholly "
+                       "in the undecided layer cannot be excluded, so no upper bound is proved",
+            },
+            "basic_regions": {
+                "count": n_regions,
+                "exact": False,
+                "lower_bound": self.lower_bound,
+                "consistent_with_proposition_1": self.consistent,
+                "why": (
+                    f"the {n_regions} regions are the sheets above the {len({r.cell for r in self.regions})} joint "
+                    "cells that carry certified boxes (each cell's certified solve gives its number of sheets per "
+                    f"aspect); {self.lower_bound} of them are pairwise certified distinct (opposite aspects, cells of "
+                    "different certified counts, distinct solutions of one joint vector); two cells of equal count "
+                    "are not proved to be different true cells, so the count is not proved exact"
+                ),
+            },
+            "uniqueness_domains": {
+                "count": len(self.domains),
+                "exact": False,
+                "lower_bound": self.domains_lower_bound,
+                "minimal": len(self.domains) == self.domains_lower_bound,
+                "why": (
+                    f"at least {self.domains_lower_bound}: the certified solutions of one joint vector lie in "
+                    "different uniqueness domains (largest number of solutions of each aspect in one cell, summed "
+                    "over the aspects); the partition found "
+                    + ("reaches this bound" if len(self.domains) == self.domains_lower_bound else "exceeds it")
+                    + "; it relies on region adjacency across the undecided layer, which is heuristic"
+                ),
+            },
+        }
+
+
+# --------------------------------------------------------------------------------------
+# Pieces of certified boxes, and the sheet each belongs to
+# --------------------------------------------------------------------------------------
+def _pieces(paving: Paving, edges: np.ndarray, joint: JointPaving, geometry: Geometry):
+    """Face-connected pieces of boxes inside an aspect and off S_c, with their cell.
+
+    Returns piece (n,) int32, piece_aspect list, piece_cell (p,) int32.  Asserts
+    that each piece maps into exactly one cell (see the module docstring).
+    """
+    n = len(paving)
+    piece = np.full(n, -1, dtype=np.int32)
+    box_cell = np.full(n, -1, dtype=np.int32)
+    aspects: list[str] = []
+    cells: list[int] = []
+    base = 0
+    for name in ASPECTS:
+        mask = (paving.labels[name] == Label.INSIDE) & (paving.labels["off_Sc"] == Label.INSIDE)
+        comp = component_labels(n, edges, mask)
+        idx = np.flatnonzero(mask)
+        if idx.size:
+            lo, hi = singular_image(geometry, paving.boxes[idx])
+            box_cell[idx] = joint.cell_of_boxes(lo, hi)
+        m = comp >= 0
+        ncomp = int(comp.max()) + 1 if np.any(m) else 0
+        if ncomp:
+            lo_cell = np.full(ncomp, np.iinfo(np.int32).max, dtype=np.int64)
+            hi_cell = np.full(ncomp, -2, dtype=np.int64)
+            np.minimum.at(lo_cell, comp[m], box_cell[m])
+            np.maximum.at(hi_cell, comp[m], box_cell[m])
+            assert np.all(lo_cell == hi_cell) and np.all(lo_cell >= 0), "a piece must map into exactly one cell"
+            cells.extend(lo_cell.tolist())
+            aspects.extend([name] * ncomp)
+        piece[m] = comp[m] + base
+        base += ncomp
+    return piece, aspects, np.array(cells, dtype=np.int32)
+
+
+def _point_in_cell(joint: JointPaving, rng, cid: int) -> tuple[Fraction, Fraction, Fraction]:
+    vox = np.argwhere(joint.cell == cid)
+    v = vox[rng.integers(len(vox))]
+    return tuple(joint.rho_min[i] + (Fraction(int(v[i])) + Fraction(1, 2)) * joint.step[i] for i in range(3))
+
+
+class _Locator:
+    """Finds the piece whose box holds a certified solution box (vectorized per query)."""
+
+    def __init__(self, paving: Paving, piece: np.ndarray):
+        self.lo, self.hi, self.piece = paving.lo, paving.hi, piece
+
+    def piece_of(self, box: np.ndarray) -> int:
+        inside = np.all((self.lo <= box[:, 0]) & (box[:, 1] <= self.hi), axis=1)
+        ids = {int(p) for p in self.piece[inside] if p >= 0}
+        return ids.pop() if len(ids) == 1 else -1
+
+
+def _solve_located(geometry, q, sign, locator):
+    """Certified solutions of q with det sign ``sign``: list of (piece or -1, box)."""
+    from .dkp import solve
+
+    res = solve(geometry, q)
+    if not res.complete or any(s.status != "unique" for s in res.solutions):
+        return None
+    return [(locator.piece_of(np.asarray(s.box)), np.asarray(s.box)) for s in res.solutions if s.det_sign == sign]
+
+
+def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tries: int = 12, seed: int = 0):
+    """Sheet of each piece (-1 undecided) by certified elimination, and the witnesses used.
+
+    Above a cell C with k = n_a(C) solutions of aspect a there are exactly k sheets.
+    k = 1: every piece is in the one sheet.  Otherwise a reference joint vector q0
+    in C whose k solutions lie in k pieces names the sheets; a piece R is then put
+    in sheet s when some q in C has one solution in R and its other k - 1
+    solutions in pieces of k - 1 known sheets other than s (the solutions of q lie
+    in k different sheets, by Theorem 1).
+    """
+    rng = np.random.default_rng(seed)
+    locator = _Locator(paving, piece)
+    sheet = np.full(len(piece_cell), -1, dtype=np.int32)
+    witnesses: list[Witness] = []
+    sign_of = {"WA1": 1, "WA2": -1}
+    groups: dict[tuple[int, str], list[int]] = {}
+    for pid, (a, c) in enumerate(zip(piece_aspect, piece_cell)):
+        groups.setdefault((int(c), a), []).append(pid)
+    vol = paving.volume()
+    piece_vol = np.bincount(piece[piece >= 0], weights=vol[piece >= 0], minlength=len(piece_cell))
+    for (cid, a), pids in sorted(groups.items()):
+        cell = joint.cells[cid]
+        k = cell.n_wa1 if a == "WA1" else cell.n_wa2
+        if k <= 0:
+            continue
+        if k == 1:
+            sheet[pids] = 0
+            continue
+        # reference: the joint vector whose solutions land in the most pieces
+        best = None
+        candidates = ([cell.witness] if cell.witness else []) + [_point_in_cell(joint, rng, cid) for _ in range(tries)]
+        for q in candidates:
+            loc = _solve_located(geometry, q, sign_of[a], locator)
+            if loc is None:
+                continue
+            landed = [p for p, _ in loc if p >= 0]
+            if best is None or len(set(landed)) > len(set(best[1])):
+                best = (q, landed, loc)
+            if len(set(landed)) == k:
+                break
+        if best is None:
+            continue
+        q0, landed, loc = best
+        if len(set(landed)) != len(landed):
+            continue  # two solutions in one piece would contradict Theorem 1: leave undecided
+        for s_idx, p in enumerate(landed):
+            sheet[p] = s_idx
+        if len(landed) >= 2:
+            witnesses.append(Witness(tuple(q0), cid, a, tuple(landed),
+                                     tuple(tuple((float(x), float(y)) for x, y in b) for p, b in loc if p >= 0)))
+        known = set(range(len(landed)))
+        # eliminate, largest pieces first; a few passes as new sheets become known
+        for _ in range(3):
+            progress = False
+            for p in sorted(pids, key=lambda t: -piece_vol[t]):
+                if sheet[p] >= 0:
+                    continue
+                boxes = np.flatnonzero(piece == p)
+                b = boxes[np.argmax(vol[boxes])]
+                centre = 0.5 * (paving.lo[b] + paving.hi[b])
+                rho = _approx_g(geometry, centre)
+                q = tuple(Fraction(float(r)).limit_denominator(10**12) for r in rho)
+                if joint.cell_at(q) != cid:
+                    continue
+                loc = _solve_located(geometry, q, sign_of[a], locator)
+                if loc is None or p not in [x for x, _ in loc]:
+                    continue
+                others = [sheet[x] for x, _ in loc if x != p and x >= 0 and sheet[x] >= 0]
+                free = known - set(others) if len(known) == k else set(range(k)) - set(others)
+                if len(others) == k - 1 and len(set(others)) == k - 1 and len(free) == 1:
+                    sheet[p] = free.pop()
+                    progress = True
+            if not progress:
+                break
+    return sheet, tuple(witnesses)
+
+
+def _approx_g(geometry, pose):
+    from .kinematics import approx_inverse_kinematics
+
+    return approx_inverse_kinematics(geometry, np.asarray(pose)[None, :])[0]
+
+
+# --------------------------------------------------------------------------------------
+# Region adjacency across the characteristic surfaces, uniqueness domains
+# --------------------------------------------------------------------------------------
+def _grow_into_layer(n: int, edges: np.ndarray, seeds: np.ndarray, layer: np.ndarray, max_steps: int = 10_000) -> np.ndarray:
+    """Multi-source growth of ids into the layer boxes (nearest seed in the box graph)."""
+    lab = seeds.copy()
+    u, v = edges
+    for _ in range(max_steps):
+        a = (lab[u] >= 0) & (lab[v] < 0) & layer[v]
+        b = (lab[v] >= 0) & (lab[u] < 0) & layer[u]
+        if not (np.any(a) or np.any(b)):
+            break
+        new = np.full(n, np.iinfo(np.int64).max, dtype=np.int64)
+        np.minimum.at(new, v[a], lab[u[a]])
+        np.minimum.at(new, u[b], lab[v[b]])
+        upd = new != np.iinfo(np.int64).max
+        lab[upd] = new[upd]
+    return lab
+
+
+def region_adjacency(paving: Paving, edges: np.ndarray, region: np.ndarray) -> set[tuple[int, int]]:
+    """Pairs of basic regions of one aspect adjacent across its characteristic surface.
+
+    The boxes of each aspect that carry no region (the enclosure of S_c and the
+    pieces whose sheet is undecided) are shared out to the nearest region by
+    growth through face adjacency; two regions are adjacent when their shares
+    touch.  A heuristic, not a certified adjacency.
+    """
+    n = len(paving)
+    adj: set[tuple[int, int]] = set()
+    for name in ASPECTS:
+        in_aspect = paving.labels[name] == Label.INSIDE
+        seeds = np.where(in_aspect & (region >= 0), region, -1).astype(np.int64)
+        lab = _grow_into_layer(n, edges, seeds, in_aspect & (region < 0))
+        u, v = edges
+        m = (lab[u] >= 0) & (lab[v] >= 0) & (lab[u] != lab[v]) & in_aspect[u] & in_aspect[v]
+        for a, b in set(zip(lab[u[m]].tolist(), lab[v[m]].tolist())):
+            adj.add((min(a, b), max(a, b)))
+    return adj
+
+
+def uniqueness_domains(regions, adjacency: set[tuple[int, int]], time_limit: float = 20.0):
+    """Fewest connected groups per aspect, with at most one region above each cell.
+
+    Returns (groups, lower_bound): groups as tuples of region ids; lower_bound is
+    the sum over the aspects of the largest number of regions above one cell
+    (those must all be in different groups).  Backtracking from that bound
+    upward; the first feasible number of groups is the minimum for this graph.
+    """
+    import networkx as nx
+
+    g = nx.Graph()
+    g.add_nodes_from(r.id for r in regions)
+    g.add_edges_from(adjacency)
+    by_id = {r.id: r for r in regions}
+    groups_all: list[tuple[int, ...]] = []
+    bound_total = 0
+    deadline = time.perf_counter() + time_limit
+    for name in ASPECTS:
+        ids = [r.id for r in regions if r.aspect == name]
+        if not ids:
+            continue
+        per_cell: dict[int, list[int]] = {}
+        for i in ids:
+            per_cell.setdefault(by_id[i].cell, []).append(i)
+        bound = max(len(v) for v in per_cell.values())
+        bound_total += bound
+        for k in range(bound, len(ids) + 1):
+            sol = _partition(ids, k, g, by_id, per_cell, deadline)
+            if sol is not None:
+                groups_all.extend(tuple(sorted(s)) for s in sol)
+                break
+        else:  # pragma: no cover - every region alone is always feasible
+            groups_all.extend((i,) for i in ids)
+    return tuple(groups_all), bound_total
+
+
+def _partition(ids, k, g, by_id, per_cell, deadline):
+    """k connected groups, one region per cell per group, covering ids; None if not found."""
+    seed_cell = max(per_cell, key=lambda c: len(per_cell[c]))
+    seeds = per_cell[seed_cell]
+    groups = [{s} for s in seeds] + [set() for _ in range(k - len(seeds))]
+    cells = [{by_id[s].cell} for s in seeds] + [set() for _ in range(k - len(seeds))]
+    rest = [i for i in ids if i not in seeds]
+
+    def search(unassigned):
+        if time.perf_counter() > deadline:
+            return False
+        if not unassigned:
+            return all(groups)
+        best, best_opts = None, None
+        for r in unassigned:  # the most constrained region first
+            opts = [gi for gi in range(k)
+                    if by_id[r].cell not in cells[gi]
+                    and (not groups[gi] or any(nb in groups[gi] for nb in g.neighbors(r)))]
+            if best_opts is None or len(opts) < len(best_opts):
+                best, best_opts = r, opts
+            if not opts:
+                break
+        for gi in best_opts:
+            if not groups[gi] and any(not grp for grp in groups[:gi]):
+                continue  # empty groups are interchangeable
+            groups[gi].add(best)
+            cells[gi].add(by_id[best].cell)
+            if search([r for r in unassigned if r != best]):
+                return True
+            groups[gi].discard(best)
+            cells[gi].discard(by_id[best].cell)
+        return False
+
+    return [set(s) for s in groups] if search(rest) else None
+
+
+# --------------------------------------------------------------------------------------
+# The whole analysis
+# --------------------------------------------------------------------------------------
+def analyse_regions(geometry: Geometry, joint: JointPaving, depth: int, progress=None) -> RegionAnalysis:
+    """Basic regions, basic components, their witnesses, Proposition 1 and uniqueness domains.
+
+    Parameters
+    ----------
+    joint : the joint-space cells with the enclosure of g(S) (:func:`joint.joint_paving`).
+    depth : octree depth of the workspace paving.
+
+    An empty aspect gives no region.  Cost: one paving with four predicates, a
+    few certified solves per (cell, aspect), and a small exact search on the
+    region graph.
+    """
+    from .predicates import aspect_components
+
+    t0 = time.perf_counter()
+    paving = pave_regions(geometry, joint, depth, progress=progress)
+    edges = shares_face(paving.level, paving.ijk, paving.depth)
+    aspect, aspect_info = aspect_components(paving, edges)
+    piece, piece_aspect, piece_cell = _pieces(paving, edges, joint, geometry)
+    sheet, witnesses = _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint)
+
+    vol = paving.volume()
+    realized = sorted({int(c) for c in piece_cell if joint.cells[int(c)].count > 0})
+    regions: list[BasicRegion] = []
+    rid_of: dict[tuple[int, str, int], int] = {}
+    for name in ASPECTS:
+        for cid in sorted(realized, key=lambda c: -joint.cells[c].n_voxels):
+            cell = joint.cells[cid]
+            k = cell.n_wa1 if name == "WA1" else cell.n_wa2
+            for s in range(k):
+                rid_of[(cid, name, s)] = len(regions)
+                regions.append(BasicRegion(len(regions), name, cid, s, cell.count, 0, 0.0, 0))
+    piece_region = np.array(
+        [rid_of.get((int(c), a, int(s)), -1) if s >= 0 else -1 for c, a, s in zip(piece_cell, piece_aspect, sheet)],
+        dtype=np.int32,
+    )
+    region = np.where(piece >= 0, piece_region[np.maximum(piece, 0)] if len(piece_region) else -1, -1).astype(np.int32)
+    nb = np.bincount(region[region >= 0], minlength=len(regions))
+    vb = np.bincount(region[region >= 0], weights=vol[region >= 0], minlength=len(regions))
+    npieces = np.bincount(piece_region[piece_region >= 0], minlength=len(regions))
+    regions = [BasicRegion(r.id, r.aspect, r.cell, r.sheet, r.cell_count, int(nb[r.id]), float(vb[r.id]),
+                           int(npieces[r.id])) for r in regions]
+
+    # certified lower bound: per aspect, one cell per distinct count, its sheets are pairwise distinct
+    lower = 0
+    for name in ASPECTS:
+        best: dict[int, int] = {}
+        for cid in realized:
+            cell = joint.cells[cid]
+            k = cell.n_wa1 if name == "WA1" else cell.n_wa2
+            best[cell.count] = max(best.get(cell.count, 0), k)
+        lower += sum(best.values())
+
+    consistency = []
+    for cid in realized:
+        cell = joint.cells[cid]
+        for name in ASPECTS:
+            k = cell.n_wa1 if name == "WA1" else cell.n_wa2
+            pids = [p for p in range(len(piece_cell)) if piece_cell[p] == cid and piece_aspect[p] == name]
+            with_boxes = len({int(sheet[p]) for p in pids if sheet[p] >= 0})
+            consistency.append({"cell": cid, "aspect": name, "expected": k, "sheets_with_boxes": with_boxes,
+                                "pieces": len(pids), "unassigned_pieces": sum(1 for p in pids if sheet[p] < 0)})
+    unrealized = tuple(c.id for c in joint.cells if c.count > 0 and c.id not in realized)
+
+    adjacency = region_adjacency(paving, edges, region)
+    groups, bound = uniqueness_domains(regions, adjacency)
+    lookup = np.full(len(regions) + 1, -1, dtype=np.int32)
+    for gi, grp in enumerate(groups):
+        lookup[list(grp)] = gi
+    domain = np.where(region >= 0, lookup[np.maximum(region, 0)], -1).astype(np.int32)
+    return RegionAnalysis(paving, edges, aspect, piece, piece_cell, region, domain, tuple(regions), witnesses,
+                          lower, tuple(consistency), unrealized, groups, bound, tuple(aspect_info),
+                          time.perf_counter() - t0)
+
+
+def label_pose(analysis: RegionAnalysis, pose: Sequence) -> dict:
+    """Certified aspect, basic region and uniqueness domain of an exact pose, or "undecided".
+
+    The pose (x, y, phi) is read exactly (decimal strings or Fractions); phi is
+    taken modulo 2 pi into the paving's range only when it is already inside it.
+    Every box of the paving that contains the pose is consulted; a label is
+    reported when one of them is certified.
+    """
+    p = analysis.paving
+    x = [Fraction(str(v)) for v in pose]
+    xf = np.array([float(v) for v in x])
+    # float filter with a margin, then the exact test on the few candidates
+    near = np.all((p.lo <= xf + 1e-9) & (xf - 1e-9 <= p.hi), axis=1)
+    cand = np.flatnonzero(near)
+    keep = [i for i in cand if all(Fraction(float(p.lo[i, j])) <= x[j] <= Fraction(float(p.hi[i, j])) for j in range(3))]
+    inside = np.zeros(len(p), dtype=bool)
+    inside[keep] = True
+    idx = np.flatnonzero(inside)
+    out = {"pose": [str(v) for v in pose], "boxes": int(idx.size), "aspect": "undecided",
+           "basic_region": "undecided", "uniqueness_domain": "undecided", "in_workspace": "undecided"}
+    for i in idx:
+        w = p.labels["W"][i]
+        if w == Label.OUTSIDE:
+            out["in_workspace"] = "no"
+        elif w == Label.INSIDE:
+            out["in_workspace"] = "yes"
+        for name in ASPECTS:
+            if p.labels[name][i] == Label.INSIDE:
+                out["aspect"] = name
+        if analysis.region[i] >= 0:
+            out["basic_region"] = int(analysis.region[i])
+        if analysis.domain[i] >= 0:
+            out["uniqueness_domain"] = int(analysis.domain[i])
+    if out["in_workspace"] == "no":
+        out["aspect"] = out["basic_region"] = out["uniqueness_domain"] = "none (outside W)"
+    return out
