@@ -1,0 +1,169 @@
+"""Basic regions and uniqueness domains: labels checked in arb, solutions separated as Theorem 1 says."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import networkx as nx
+import numpy as np
+import pytest
+from flint import arb, ctx
+
+from intervalkin import kinematics as K
+from intervalkin.dkp import solve
+from intervalkin.joint import joint_paving
+from intervalkin.paving import Label
+from intervalkin.predicates import pave_workspace
+from intervalkin.regions import analyse_regions, label_pose, uniqueness_domains
+
+
+@pytest.fixture(scope="module")
+def chain(paper_geometry):
+    p = pave_workspace(paper_geometry, 7)
+    sel = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
+    jp = joint_paving(paper_geometry, p.boxes[sel], 6, max_solves=200)
+    ra = analyse_regions(paper_geometry, jp, 7)
+    return jp, ra
+
+
+def test_region_boxes_hold_their_labels_in_arb(chain, paper_geometry):
+    """Points of region boxes: det A has the aspect's sign, the legs are within limits, g(X) is in the cell."""
+    jp, ra = chain
+    p = ra.paving
+    rng = np.random.default_rng(4)
+    idx = np.flatnonzero(ra.region >= 0)
+    pick = rng.choice(idx, size=min(400, idx.size), replace=False)
+    old = ctx.prec
+    ctx.prec = 128
+    try:
+        for i in pick:
+            r = ra.regions[ra.region[i]]
+            t = rng.uniform(0, 1, 3)
+            X = p.lo[i] + t * (p.hi[i] - p.lo[i])
+            x, y, phi = (arb(float(v)) for v in X)
+            d = K.det_a_arb(paper_geometry, x, y, phi)
+            assert (d > 0) if r.aspect == "WA1" else (d < 0)
+            rho = K.inverse_kinematics_arb(paper_geometry, x, y, phi)
+            assert all(v > 10 and v < 32 for v in rho)
+            lo = np.array([[float(v.lower()) for v in rho]])
+            hi = np.array([[float(v.upper()) for v in rho]])
+            ilo, ihi, _ = jp.index_ranges(lo, hi)
+            block = jp.cell[ilo[0, 0]:ihi[0, 0] + 1, ilo[0, 1]:ihi[0, 1] + 1, ilo[0, 2]:ihi[0, 2] + 1]
+            assert np.all(block == r.cell)
+    finally:
+        ctx.prec = old
+
+
+def test_pieces_are_connected_and_partition_the_certified_boxes(chain):
+    jp, ra = chain
+    p = ra.paving
+    certified = np.zeros(len(p), bool)
+    for a in ("WA1", "WA2"):
+        certified |= (p.labels[a] == Label.INSIDE) & (p.labels["off_Sc"] == Label.INSIDE)
+    assert np.array_equal(certified, ra.piece >= 0)
+    g = nx.Graph()
+    g.add_edges_from(ra.edges.T.tolist())
+    rng = np.random.default_rng(0)
+    for pid in rng.choice(ra.piece.max() + 1, size=min(30, ra.piece.max() + 1), replace=False):
+        members = np.flatnonzero(ra.piece == pid).tolist()
+        sub = g.subgraph(members).copy()
+        sub.add_nodes_from(members)
+        assert nx.is_connected(sub)
+    # no face between two different pieces (they would be one component)
+    u, v = ra.edges
+    both = (ra.piece[u] >= 0) & (ra.piece[v] >= 0)
+    assert np.all(ra.piece[u[both]] == ra.piece[v[both]])
+
+
+def test_solutions_of_random_joint_vectors_are_separated(chain, paper_geometry):
+    """Property (Theorem 1, Theorem 2): solutions of one q lie in distinct regions and domains."""
+    jp, ra = chain
+    p = ra.paving
+    rng = np.random.default_rng(8)
+    realized = sorted({r.cell for r in ra.regions})
+    labelled = 0
+    for _ in range(200):
+        cid = realized[rng.integers(len(realized))]
+        vox = np.argwhere(jp.cell == cid)
+        v = vox[rng.integers(len(vox))]
+        q = tuple(jp.rho_min[i] + (int(v[i]) + Fraction(int(rng.integers(1, 99)), 100)) * jp.step[i] for i in range(3))
+        res = solve(paper_geometry, q)
+        assert res.complete
+        regions, domains = [], []
+        for s in res.solutions:
+            box = np.asarray(s.box)
+            inside = np.flatnonzero(np.all((p.lo <= box[:, 0]) & (box[:, 1] <= p.hi), axis=1))
+            reg = {int(ra.region[i]) for i in inside if ra.region[i] >= 0}
+            dom = {int(ra.domain[i]) for i in inside if ra.domain[i] >= 0}
+            if reg:
+                assert len(reg) == 1
+                r = ra.regions[reg.pop()]
+                assert r.cell == cid
+                assert (r.aspect == "WA1") == (s.det_sign > 0)
+                regions.append(r.id)
+            if dom:
+                domains.append(dom.pop())
+        assert len(regions) == len(set(regions))
+        assert len(domains) == len(set(domains))
+        labelled += len(regions)
+    assert labelled > 100
+
+
+def test_witnesses_are_confirmed_by_an_independent_solve(chain, paper_geometry):
+    jp, ra = chain
+    p = ra.paving
+    assert ra.witnesses
+    for w in ra.witnesses:
+        res = solve(paper_geometry, w.rho)
+        assert res.complete
+        sign = 1 if w.aspect == "WA1" else -1
+        found = []
+        for s in res.solutions:
+            if s.det_sign != sign:
+                continue
+            box = np.asarray(s.box)
+            inside = np.flatnonzero(np.all((p.lo <= box[:, 0]) & (box[:, 1] <= p.hi), axis=1))
+            pieces = {int(ra.piece[i]) for i in inside if ra.piece[i] >= 0}
+            found.extend(pieces)
+        assert set(w.pieces) <= set(found)
+        assert len(set(w.pieces)) == len(w.pieces)
+
+
+def test_uniqueness_domains_respect_theorem_2(chain):
+    jp, ra = chain
+    by_id = {r.id: r for r in ra.regions}
+    for grp in ra.domains:
+        cells = [by_id[i].cell for i in grp]
+        assert len(cells) == len(set(cells))
+        assert len({by_id[i].aspect for i in grp}) == 1
+    assert sorted(i for grp in ra.domains for i in grp) == sorted(by_id)
+    assert len(ra.domains) >= ra.domains_lower_bound
+    # the paper's bound: at least the largest number of solutions (6)
+    assert ra.domains_lower_bound >= 6
+
+
+def test_uniqueness_domains_on_a_small_graph():
+    """Hand-made: two cells with 2 regions each per aspect, a path graph: 2 groups are enough."""
+    from intervalkin.regions import BasicRegion
+
+    regs = [BasicRegion(i, "WA1", c, s, 4, 1, 1.0, 1) for i, (c, s) in enumerate([(0, 0), (0, 1), (1, 0), (1, 1)])]
+    groups, bound = uniqueness_domains(regs, {(0, 2), (1, 3)})
+    assert bound == 2 and sorted(groups) == [(0, 2), (1, 3)]
+    groups, _ = uniqueness_domains(regs, {(0, 1), (2, 3)})  # no valid pairing: each alone
+    assert len(groups) == 4
+
+
+def test_label_of_table1_solutions(chain):
+    jp, ra = chain
+    rows = {2: ("-5.495660815453", "-13.935498276039", "-0.047331369367"),
+            3: ("-14.896128100173", "1.582961661963", "0.245309530992"),
+            6: ("14.673943655735", "-3.012603124926", "2.132904365129")}
+    seen = []
+    for k, pose in rows.items():
+        lab = label_pose(ra, pose)
+        assert lab["aspect"] in ("WA1", "undecided")
+        if lab["uniqueness_domain"] != "undecided":
+            seen.append(lab["uniqueness_domain"])
+    assert len(seen) == len(set(seen))
+    out = label_pose(ra, ("40", "40", "0"))
+    assert out["boxes"] == 0 or out["in_workspace"] in ("no", "undecided")
