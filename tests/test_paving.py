@@ -222,3 +222,22 @@ def test_depth_refused_when_memory_short(monkeypatch):
 def test_bad_domain():
     with pytest.raises(InputError):
         pave_multi(np.zeros((3, 2)), [("a", lambda b: np.full(len(b), 3, np.uint8))], 2)
+
+
+def test_locate_boxes_matches_brute_force(paper_geometry):
+    """The key lookup finds exactly the leaf that contains a small query box, or -1."""
+    from intervalkin.predicates import pave_workspace
+
+    p = pave_workspace(paper_geometry, 5)
+    rng = np.random.default_rng(3)
+    pts = np.column_stack([rng.uniform(-32, 32, 500), rng.uniform(-32, 32, 500), rng.uniform(-3.14, 3.14, 500)])
+    # include points on box faces, where no leaf contains a box around them
+    pts[:50] = p.lo[rng.integers(len(p), size=50)]
+    q = np.stack([pts - 1e-9, pts + 1e-9], axis=-1)
+    idx = p.locate_boxes(q)
+    for k in range(len(q)):
+        holders = np.flatnonzero(np.all((p.lo <= q[k, :, 0]) & (q[k, :, 1] <= p.hi), axis=1))
+        if idx[k] >= 0:
+            assert idx[k] in holders
+        else:
+            assert holders.size == 0

@@ -131,9 +131,11 @@ def render_slices(paving: Paving, codes: np.ndarray, palette, names, path, title
     for ax in axes.ravel()[len(phis):]:
         ax.axis("off")
     handles = [Patch(color=c, label=n) for c, n in zip(palette, names)]
-    fig.legend(handles=handles, loc="lower center", ncol=len(names), fontsize=9, frameon=False)
+    ncol = min(len(names), 10)
+    rows = int(np.ceil(len(names) / ncol)) if names else 1
+    fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=8 if rows > 1 else 9, frameon=False)
     fig.suptitle(title, fontsize=11)
-    fig.tight_layout(rect=(0, 0.05, 1, 0.96), h_pad=1.6)
+    fig.tight_layout(rect=(0, 0.03 + 0.03 * rows, 1, 0.96), h_pad=1.6)
     fig.savefig(path)
     plt.close(fig)
     return Path(path)
@@ -172,4 +174,149 @@ def render_all(paving: Paving, out_dir, max_points: int = 40000) -> list[Path]:
     files.append(render_slices(paving, codes_a, [_WA1, _WA2, "#222222", "#bbbbbb"],
                                ["WA1 (det A > 0)", "WA2 (det A < 0)", "singular layer", "W undecided"],
                                out / "aspects_slices.png", f"Aspects and singular layer, phi-slices (depth {paving.depth})"))
+    return files
+
+
+# --------------------------------------------------------------------------------------
+# Joint space (paper Figs. 2 and 11) and the definition sets (Figs. 9, 10, 12, 13)
+# --------------------------------------------------------------------------------------
+_COUNT_COLOURS = {0: "#dddddd", 2: "#8ecae6", 4: "#ffb703", 6: "#d62828"}
+
+
+def _palette(k: int) -> list[str]:
+    plt = _plt()
+    cmaps = [plt.get_cmap("tab20"), plt.get_cmap("tab20b"), plt.get_cmap("tab20c")]
+    colours = []
+    for cm in cmaps:
+        colours.extend(cm(i) for i in range(20))
+    return [colours[i % len(colours)] for i in range(max(k, 1))]
+
+
+def render_joint(joint, out_dir, max_points: int = 60000, seed: int = 0) -> list[Path]:
+    """Joint-space cells coloured by certified solution count: a 3-D view and rho3-slices."""
+    plt = _plt()
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    cols = joint.columns()
+    count = cols["count"]
+    centre = 0.5 * (cols["lo"] + cols["hi"])
+    rng = np.random.default_rng(seed)
+    fig = plt.figure(figsize=(7.5, 6.5), dpi=110)
+    ax = fig.add_subplot(projection="3d")
+    for k in (2, 4, 6):
+        idx = _subsample(np.flatnonzero(count == k), max_points // 3, rng)
+        if idx.size:
+            ax.scatter(*centre[idx].T, s=2, c=_COUNT_COLOURS[k], alpha=0.35, linewidths=0,
+                       label=f"{k} solutions ({np.count_nonzero(count == k)} voxels)")
+    ax.set_xlabel("rho1")
+    ax.set_ylabel("rho2")
+    ax.set_zlabel("rho3")
+    ax.set_title(f"Joint space: certified cells by number of solutions\n(voxels 2^-{joint.depth}; cf. paper Figs. 2, 11)",
+                 fontsize=10)
+    leg = ax.legend(loc="upper left", fontsize=8, markerscale=5)
+    for h in leg.legend_handles:
+        h.set_alpha(1)
+    fig.tight_layout()
+    p3 = out / "joint_3d.png"
+    fig.savefig(p3)
+    plt.close(fig)
+
+    n = joint.n
+    grid = count.reshape(n, n, n)
+    codes = np.full(grid.shape, 0, dtype=np.int16)  # 0 undecided
+    for j, k in enumerate((0, 2, 4, 6)):
+        codes[grid == k] = j + 1
+    palette = ["#555555", _COUNT_COLOURS[0], _COUNT_COLOURS[2], _COUNT_COLOURS[4], _COUNT_COLOURS[6]]
+    names = ["may meet g(S)", "0 solutions", "2 solutions", "4 solutions", "6 solutions"]
+    ks = np.linspace(0, n - 1, 8).round().astype(int)
+    fig, axes = plt.subplots(2, 4, figsize=(13, 7.4), dpi=100)
+    r0 = [float(v) for v in joint.rho_min]
+    h = [float(v) for v in joint.step]
+    ext = (r0[0], r0[0] + n * h[0], r0[1], r0[1] + n * h[1])
+    for a, kk in zip(axes.ravel(), ks):
+        a.imshow(codes[:, :, kk].T, origin="lower", cmap=ListedColormap(palette), vmin=0, vmax=4,
+                 interpolation="nearest", extent=ext)
+        a.set_title(f"rho3 = {r0[2] + (kk + 0.5) * h[2]:.2f}", fontsize=9)
+        a.set_xlabel("rho1", fontsize=8)
+        a.set_ylabel("rho2", fontsize=8)
+        a.tick_params(labelsize=7)
+    fig.legend(handles=[Patch(color=c, label=t) for c, t in zip(palette, names)], loc="lower center", ncol=5,
+               fontsize=9, frameon=False)
+    fig.suptitle("Joint space, rho3-slices: certified solution count per voxel", fontsize=11)
+    fig.tight_layout(rect=(0, 0.05, 1, 0.96))
+    ps = out / "joint_slices.png"
+    fig.savefig(ps)
+    plt.close(fig)
+    return [p3, ps]
+
+
+def render_ids_3d(paving: Paving, ids: np.ndarray, path, title: str, names=None, max_points: int = 60000,
+                  seed: int = 0) -> Path:
+    """3-D scatter of box centres coloured by an integer id per box (-1 not drawn)."""
+    k = int(ids.max()) + 1 if ids.size and ids.max() >= 0 else 0
+    pal = _palette(k)
+    layers = [(ids == i, pal[i], names[i] if names else f"{i}") for i in range(k)]
+    return render_3d(paving, layers, path, title, max_points=max_points, seed=seed)
+
+
+def render_ids_slices(paving: Paving, ids: np.ndarray, path, title: str, names=None, extra=None) -> Path:
+    """phi-slices coloured by an integer id per box; ``extra`` = (mask, colour, name) drawn underneath."""
+    k = int(ids.max()) + 1 if ids.size and ids.max() >= 0 else 0
+    pal = list(_palette(k))
+    nm = list(names) if names else [f"{i}" for i in range(k)]
+    codes = ids.astype(np.int16).copy()
+    if extra is not None:
+        mask, colour, name = extra
+        codes = np.where((codes < 0) & mask, k, codes).astype(np.int16)
+        pal.append(colour)
+        nm.append(name)
+    short = [n.split(":")[0] for n in nm] if len(nm) > 10 else nm
+    return render_slices(paving, codes, pal, short, path, title)
+
+
+def render_regions(analysis, out_dir) -> list[Path]:
+    """The paper's Figures 9, 10, 12 and 13 from a :class:`regions.RegionAnalysis`."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    p = analysis.paving
+    files = []
+    in_aspect = (p.labels["WA1"] == Label.INSIDE) | (p.labels["WA2"] == Label.INSIDE)
+    sc = in_aspect & (p.labels["off_Sc"] != Label.INSIDE)
+    sing = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
+    codes = np.full(len(p), -1, np.int16)
+    codes[(p.labels["WA1"] == Label.INSIDE) & ~sc] = 0
+    codes[(p.labels["WA2"] == Label.INSIDE) & ~sc] = 1
+    codes[sc] = 2
+    codes[sing] = 3
+    files.append(render_slices(p, codes, [_WA1, _WA2, "#ffb703", "#222222"],
+                               ["WA1 off S_c", "WA2 off S_c", "may meet S_c (characteristic)", "singular layer"],
+                               out / "characteristic_slices.png",
+                               f"Characteristic surfaces S_c1, S_c2 (outer enclosure; cf. paper Fig. 9), depth {p.depth}"))
+    files.append(render_3d(p, [(sc & (p.labels["WA1"] == Label.INSIDE), "#ffb703", "S_c1 enclosure"),
+                               (sing & (p.labels["W"] == Label.INSIDE), "#222222", "singular layer")],
+                           out / "characteristic_3d.png", "Characteristic surface of WA1 and singular layer (Fig. 9)"))
+    names = [f"{r.id}: {r.aspect} cell {r.cell} ({r.cell_count} sol.)" for r in analysis.regions]
+    files.append(render_ids_slices(p, analysis.region, out / "basic_regions_slices.png",
+                                   f"{len(analysis.regions)} basic regions (cf. paper Fig. 10)", names,
+                                   extra=(sc, "#eeeeee", "undecided")))
+    files.append(render_ids_3d(p, analysis.region, out / "basic_regions_3d.png",
+                               f"Basic regions (cf. paper Fig. 10)", names))
+    dnames = [f"domain {i}" for i in range(len(analysis.domains))]
+    files.append(render_ids_slices(p, analysis.domain, out / "uniqueness_domains_slices.png",
+                                   f"{len(analysis.domains)} uniqueness domains (cf. paper Fig. 12)", dnames,
+                                   extra=(in_aspect, "#eeeeee", "undecided")))
+    files.append(render_ids_3d(p, analysis.domain, out / "uniqueness_domains_3d.png",
+                               "Uniqueness domains (cf. paper Fig. 12)", dnames))
+    if analysis.regions:
+        top = max(analysis.regions, key=lambda r: (r.cell_count, r.n_boxes)).cell
+        sel = [r.id for r in analysis.regions if r.cell == top]
+        ids = np.where(np.isin(analysis.region, sel), analysis.region, -1)
+        remap = {rid: i for i, rid in enumerate(sel)}
+        ids = np.array([remap.get(int(v), -1) for v in ids], dtype=np.int32) if len(sel) else ids
+        files.append(render_ids_3d(p, ids, out / "top_cell_regions_3d.png",
+                                   f"The {len(sel)} basic regions above cell {top} (cf. paper Fig. 13)",
+                                   [f"region {rid} ({analysis.regions[rid].aspect})" for rid in sel]))
     return files

@@ -194,6 +194,40 @@ class Paving:
         return Paving(self.domain, self.depth, self.level[mask], self.ijk[mask], self.lo[mask], self.hi[mask],
                       {k: v[mask] for k, v in self.labels.items()}, list(self.stats))
 
+    def locate_boxes(self, boxes: np.ndarray) -> np.ndarray:
+        """Index of the leaf that contains each query box (m, 3, 2) entirely, or -1.
+
+        Candidates come from integer keys (the leaf holding the query's lower
+        corner, one lookup per level); containment is then checked on the float
+        bounds, so the answer is exact for the float boxes given.
+        """
+        boxes = np.asarray(boxes, dtype=np.float64).reshape(-1, 3, 2)
+        m = boxes.shape[0]
+        out = np.full(m, -1, dtype=np.int64)
+        if m == 0 or len(self) == 0:
+            return out
+        width = self.domain[:, 1] - self.domain[:, 0]
+        nfine = np.int64(1) << self.depth
+        t = (boxes[:, :, 0] - self.domain[:, 0]) / width * nfine
+        fine = np.clip(np.floor(t), 0, nfine - 1).astype(np.int64)
+        level = self.level.astype(np.int64)
+        nb = self.depth + 1
+        keys = (level << (3 * nb)) | (self.ijk[:, 0] << (2 * nb)) | (self.ijk[:, 1] << nb) | self.ijk[:, 2]
+        order = np.argsort(keys)
+        sk = keys[order]
+        for L in range(self.depth + 1):
+            c = fine >> (self.depth - L)
+            qk = (np.int64(L) << (3 * nb)) | (c[:, 0] << (2 * nb)) | (c[:, 1] << nb) | c[:, 2]
+            pos = np.minimum(np.searchsorted(sk, qk), sk.size - 1)
+            hit = (sk[pos] == qk) & (out < 0)
+            out[hit] = order[pos[hit]]
+        ok = out >= 0
+        idx = out[ok]
+        inside = np.all((self.lo[idx] <= boxes[ok, :, 0]) & (boxes[ok, :, 1] <= self.hi[idx]), axis=1)
+        res = np.full(m, -1, dtype=np.int64)
+        res[np.flatnonzero(ok)[inside]] = idx[inside]
+        return res
+
     def fine_coordinates(self) -> tuple[np.ndarray, np.ndarray]:
         """Integer bounds (n, 3) in units of the leaf width at ``depth``: [lo, hi)."""
         shift = (self.depth - self.level.astype(np.int64))[:, None]

@@ -284,12 +284,11 @@ class _Locator:
     """Finds the piece whose box holds a certified solution box (vectorized per query)."""
 
     def __init__(self, paving: Paving, piece: np.ndarray):
-        self.lo, self.hi, self.piece = paving.lo, paving.hi, piece
+        self.paving, self.piece = paving, piece
 
     def piece_of(self, box: np.ndarray) -> int:
-        inside = np.all((self.lo <= box[:, 0]) & (box[:, 1] <= self.hi), axis=1)
-        ids = {int(p) for p in self.piece[inside] if p >= 0}
-        return ids.pop() if len(ids) == 1 else -1
+        i = int(self.paving.locate_boxes(box[None])[0])
+        return int(self.piece[i]) if i >= 0 else -1
 
 
 def _solve_located(geometry, q, sign, locator):
