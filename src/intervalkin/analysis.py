@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,8 @@ import numpy as np
 from .errors import InputError
 from .paving import Label, Paving, check_depth, shares_face
 
-__all__ = ["run_pave", "pave_summary", "CERTIFIED_NOTE", "ProgressBar"]
+__all__ = ["run_pave", "pave_summary", "CERTIFIED_NOTE", "ProgressBar", "Analysis", "analyse", "run_analyze",
+           "chain_summary", "write_chain", "DEFAULT_DEPTH"]
 
 CERTIFIED_NOTE = {
     "labels": "Every INSIDE / OUTSIDE box label is proved with outward-rounded interval arithmetic "
@@ -146,3 +148,383 @@ def run_pave(geometry_path, depth, out, figures: bool = True, progress: bool = T
     write_json(out / "summary.json", summary)
     sys.stdout.write(_table(summary) + "\n")
     return 0
+
+
+# ======================================================================================
+# The whole chain: workspace, singular surface, joint cells, regions, domains
+# ======================================================================================
+MARKER = ".intervalkin-output"
+#: Default octree depth of ``analyze`` / ``paper`` (about a minute on two cores).
+DEFAULT_DEPTH = 8
+MAX_CHAIN_DEPTH = 9
+
+
+class Stages:
+    """Stage names and timings on stderr (silent when quiet)."""
+
+    def __init__(self, quiet: bool = False, stream=None):
+        self.quiet = quiet
+        self.stream = stream if stream is not None else sys.stderr
+        self.t0 = time.perf_counter()
+        self.timings: dict[str, float] = {}
+        self._name = None
+        self._start = 0.0
+
+    def start(self, name: str) -> None:
+        self._name, self._start = name, time.perf_counter()
+        if not self.quiet:
+            self.stream.write(f"[{time.perf_counter() - self.t0:6.1f} s] {name} ...\n")
+            self.stream.flush()
+
+    def done(self) -> None:
+        self.timings[self._name] = time.perf_counter() - self._start
+
+    def bar(self):
+        return None if self.quiet else ProgressBar(self.stream)
+
+
+def chain_depths(depth: int) -> tuple[int, int, int]:
+    """(workspace depth, singular-layer depth, joint depth) for a user depth."""
+    return depth, depth + 1, min(depth - 1, 7)
+
+
+@dataclass(frozen=True, eq=False)
+class Analysis:
+    """The definition sets of one manipulator, as certified pavings and counts."""
+
+    geometry: object
+    depth: int
+    singular_depth: int
+    joint_depth: int
+    n_singular_boxes: int
+    joint: object
+    regions: object
+    timings: dict
+
+
+def analyse(geometry, depth: int = DEFAULT_DEPTH, stages: Stages | None = None) -> Analysis:
+    """Run the chain geometry -> singular layer -> joint cells -> regions -> uniqueness domains.
+
+    ``depth`` is the octree depth of the workspace paving; the singular layer
+    is paved one level deeper and the joint grid has 2**min(depth - 1, 7) voxels
+    per axis (see :func:`chain_depths`).
+    """
+    from .joint import joint_paving, pave_singular_layer
+    from .regions import analyse_regions
+
+    if isinstance(depth, bool) or not isinstance(depth, int) or not 3 <= depth <= MAX_CHAIN_DEPTH:
+        raise InputError(f"--depth: expected an integer in 3..{MAX_CHAIN_DEPTH}, got {depth!r}")
+    check_depth(depth + 1)
+    st = stages or Stages(quiet=True)
+    dw, ds, dj = chain_depths(depth)
+    st.start(f"singular layer (depth {ds})")
+    sing = pave_singular_layer(geometry, ds, progress=st.bar())
+    st.done()
+    st.start(f"joint space: enclosure of g(S) and certified cells (2^{dj} voxels per axis)")
+    jp = joint_paving(geometry, sing, dj)
+    st.done()
+    st.start(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})")
+    ra = analyse_regions(geometry, jp, dw, progress=st.bar())
+    st.done()
+    return Analysis(geometry, dw, ds, dj, len(sing), jp, ra, dict(st.timings))
+
+
+def joint_summary(jp) -> dict:
+    """The joint-space part of summary.json."""
+    return {
+        "depth": jp.depth,
+        "voxels_per_axis": jp.n,
+        "cells": [c.to_json() for c in jp.cells],
+        "volume_by_count": jp.volume_by_count(),
+        "undecided_share": float(jp.marked.mean()),
+        "singular_boxes": jp.n_singular_boxes,
+        "certified": {
+            "counts": "each cell is a face-connected set of voxels certified off the outer enclosure of g(S); "
+                      "its count and aspect split come from one certified solve and hold at every point of it",
+            "distinct": "cells with different counts are different components of the joint box minus g(S); "
+                        "two cells with equal counts may be one true component joined through the undecided layer",
+        },
+    }
+
+
+def chain_summary(a: Analysis) -> dict:
+    """summary.json of the whole chain (counts with their certification status first)."""
+    ra = a.regions
+    p = ra.paving
+    counts = ra.counts()
+    out = dict(counts)
+    out.update(
+        {
+            "geometry": a.geometry.name,
+            "depth": {"workspace": a.depth, "singular_layer": a.singular_depth, "joint": a.joint_depth},
+            "W": {"boxes": p.count_by_label("W"), "volume": p.volume_by_label("W")},
+            "WA1": {"boxes": p.count_by_label("WA1"), "volume": p.volume_by_label("WA1")},
+            "WA2": {"boxes": p.count_by_label("WA2"), "volume": p.volume_by_label("WA2")},
+            "aspect_components": list(ra.aspect_info),
+            "joint": joint_summary(a.joint),
+            "basic_region_list": [r.to_json() for r in ra.regions],
+            "uniqueness_domain_list": [list(g) for g in ra.domains],
+            "consistency": list(ra.consistency),
+            "cells_without_regions": list(ra.unrealized_cells),
+            "witnesses": [w.to_json() for w in ra.witnesses],
+            "undecided_volume": {
+                name: p.volume_by_label(name)["boundary"] for name in ("W", "WA1", "WA2")
+            },
+            "characteristic_layer_volume": float(
+                p.volume()[((p.labels["WA1"] == Label.INSIDE) | (p.labels["WA2"] == Label.INSIDE))
+                           & (p.labels["off_Sc"] != Label.INSIDE)].sum()
+            ),
+            "timings_seconds": a.timings,
+            "certified": CERTIFIED_NOTE,
+        }
+    )
+    return out
+
+
+def prepare_output_dir(out, force: bool) -> Path:
+    """Create ``out`` or accept it when empty / an earlier intervalkin output; refuse otherwise."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out: {str(out)!r} exists and is not a folder")
+    if out.is_dir() and any(out.iterdir()) and not (out / MARKER).exists() and not force:
+        raise InputError(f"--out: {str(out)!r} is not empty and not an intervalkin output (use --force to write there)")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / f".{MARKER}.probe"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise InputError(f"--out: cannot write to {str(out)!r} ({exc.strerror or exc})") from None
+    from .export import atomic_write_bytes
+
+    atomic_write_bytes(out / MARKER, b"intervalkin output folder\n")
+    return out
+
+
+def write_chain(a: Analysis, out: Path, figures: bool = True, stages: Stages | None = None) -> dict:
+    """Write pavings (npz, VTK), figures and summary.json of an analysis; returns the summary."""
+    from .export import atomic_write_bytes, paving_columns, write_json, write_npz, write_vtu
+
+    st = stages or Stages(quiet=True)
+    ra = a.regions
+    p = ra.paving
+    st.start("writing pavings (npz, VTK)")
+    extra = {"basic_region": ra.region.astype(np.int32), "uniqueness_domain": ra.domain.astype(np.int32)}
+    write_npz(out / "pavings" / "workspace.npz", p, ra.aspect, extra)
+    cols = paving_columns(p, ra.aspect, extra)
+    write_vtu(out / "pavings" / "workspace.vtu", p.lo, p.hi,
+              {k: cols[k] for k in ("in_workspace", "det_sign", "aspect", "basic_region", "uniqueness_domain", "depth")})
+    jc = a.joint.columns()
+    atomic_write_bytes(out / "pavings" / "joint.npz", _npz_bytes(jc))
+    st.done()
+    files = ["pavings/workspace.npz", "pavings/workspace.vtu", "pavings/joint.npz"]
+    if figures:
+        st.start("figures")
+        from .figures import render_all, render_joint, render_regions
+
+        figs = render_all(p, out / "figures") + render_joint(a.joint, out / "figures") + render_regions(ra, out / "figures")
+        files += [f"figures/{f.name}" for f in figs]
+        st.done()
+    summary = chain_summary(a)
+    summary["timings_seconds"] = {**a.timings, **st.timings}
+    summary["files"] = files
+    write_json(out / "summary.json", summary)
+    return summary
+
+
+def _npz_bytes(cols: dict) -> bytes:
+    import io
+
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **cols)
+    return buf.getvalue()
+
+
+def chain_table(summary: dict) -> str:
+    """A short terminal table of the counts and their status."""
+    def status(block):
+        if block.get("exact"):
+            return "exact"
+        return f"found; certified lower bound {block['lower_bound']}"
+
+    rows = [
+        f"{'set':<22}{'count':>7}   status",
+        f"{'aspects':<22}{summary['aspects']['count']:>7}   {status(summary['aspects'])}",
+        f"{'basic regions':<22}{summary['basic_regions']['count']:>7}   {status(summary['basic_regions'])}",
+        f"{'uniqueness domains':<22}{summary['uniqueness_domains']['count']:>7}   {status(summary['uniqueness_domains'])}"
+        + ("  (minimal)" if summary["uniqueness_domains"].get("minimal") else ""),
+    ]
+    cells = [c for c in summary["joint"]["cells"] if c["count"] > 0 and c["voxels"] > 1]
+    by = {}
+    for c in cells:
+        by.setdefault(c["count"], []).append(c["share"])
+    rows.append("joint cells (count: number, share of the joint box): "
+                + ", ".join(f"{k}: {len(v)} ({100 * sum(v):.1f}%)" for k, v in sorted(by.items())))
+    u = summary["undecided_volume"]
+    rows.append(f"undecided volume: W {u['W']:.1f}, WA1 {u['WA1']:.1f}, WA2 {u['WA2']:.1f}; "
+                f"depth {summary['depth']['workspace']} (singular {summary['depth']['singular_layer']}, "
+                f"joint {summary['depth']['joint']})")
+    return "\n".join(rows)
+
+
+def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool = False, as_json: bool = False,
+                figures: bool = True, certificates: bool = True, paper: bool = False) -> int:
+    """``intervalkin analyze`` (and ``paper`` when paper=True): the whole chain into one folder."""
+    import json
+
+    from .geometry import default_geometry, geometry_from_option
+
+    geometry = default_geometry() if paper else geometry_from_option(geometry_path)
+    if isinstance(depth, bool) or not isinstance(depth, int) or not 3 <= depth <= MAX_CHAIN_DEPTH:
+        raise InputError(f"--depth: expected an integer in 3..{MAX_CHAIN_DEPTH}, got {depth!r}")
+    check_depth(depth + 1)
+    out = prepare_output_dir(out, force)
+    st = Stages(quiet=quiet)
+    a = analyse(geometry, depth, st)
+    summary = write_chain(a, out, figures=figures, stages=st)
+    if certificates:
+        st.start("certificates")
+        cert_files = _write_certificates(a, out)
+        st.done()
+        summary["files"] += cert_files
+    if paper:
+        st.start("paper report")
+        from .paper import write_report
+
+        summary["files"].append(write_report(a, summary, out, st.timings))
+        st.done()
+    summary["timings_seconds"] = {**summary["timings_seconds"], **st.timings,
+                                  "total": time.perf_counter() - st.t0}
+    from .export import write_json
+
+    write_json(out / "summary.json", summary)
+    if as_json:
+        sys.stdout.write(json.dumps(summary) + "\n")
+    elif not quiet:
+        sys.stdout.write(chain_table(summary) + f"\nwritten to {out}/ in {summary['timings_seconds']['total']:.1f} s\n")
+    return 0
+
+
+def _write_certificates(a: Analysis, out: Path) -> list[str]:
+    """Certificates of the claims (written by :mod:`intervalkin.certificates` when present)."""
+    try:
+        from .certificates import write_certificates
+    except ImportError:  # pragma: no cover - the certificates module ships with the package
+        return []
+    from .dkp import solve
+
+    dkp_results = []
+    if a.geometry.name == "Wenger-Chablat 1997":
+        from .paper import TABLE1_RHO
+
+        dkp_results.append(solve(a.geometry, TABLE1_RHO))
+    paths = write_certificates(out / "certificates", a.geometry, dkp_results=dkp_results, joint=a.joint,
+                               regions=a.regions)
+    return [f"certificates/{Path(p).name}" for p in paths]
+
+
+def joint_table(jp) -> str:
+    rows = [f"{'cell':>5}{'count':>7}{'WA1':>5}{'WA2':>5}{'voxels':>10}{'volume':>11}{'share':>8}   witness rho"]
+    for c in jp.cells:
+        if c.n_voxels < 2 and len(jp.cells) > 40:
+            continue
+        w = "-" if c.witness is None else ", ".join(f"{float(v):.4f}" for v in c.witness)
+        cnt = str(c.count) if c.count >= 0 else "?"
+        rows.append(f"{c.id:>5}{cnt:>7}{c.n_wa1:>5}{c.n_wa2:>5}{c.n_voxels:>10}{c.volume:>11.2f}{100 * c.share:>7.2f}%   ({w})")
+    vb = jp.volume_by_count()
+    rows.append("volume by count: " + ", ".join(f"{k}: {v:.1f}" for k, v in vb.items())
+                + f"  (joint box volume {sum(vb.values()):.1f})")
+    return "\n".join(rows)
+
+
+def run_joint(geometry_path, depth: int, out, force: bool = False, quiet: bool = False, figures: bool = True) -> int:
+    """``intervalkin joint``: the enclosure of g(S), the certified cells and their table."""
+    from .export import atomic_write_bytes, write_json
+    from .geometry import geometry_from_option
+    from .joint import joint_paving, pave_singular_layer
+
+    if isinstance(depth, bool) or not isinstance(depth, int) or not 2 <= depth <= 8:
+        raise InputError(f"--depth: expected an integer in 2..8 (voxels per axis 2**depth), got {depth!r}")
+    geometry = geometry_from_option(geometry_path)
+    out = prepare_output_dir(out, force)
+    st = Stages(quiet=quiet)
+    ds = min(depth + 2, 10)
+    check_depth(ds)
+    st.start(f"singular layer (depth {ds})")
+    sing = pave_singular_layer(geometry, ds, progress=st.bar())
+    st.done()
+    st.start(f"joint space cells (2^{depth} voxels per axis)")
+    jp = joint_paving(geometry, sing, depth)
+    st.done()
+    atomic_write_bytes(out / "pavings" / "joint.npz", _npz_bytes(jp.columns()))
+    files = ["pavings/joint.npz"]
+    if figures:
+        st.start("figures")
+        from .figures import render_joint
+
+        files += [f"figures/{f.name}" for f in render_joint(jp, out / "figures")]
+        st.done()
+    summary = {"geometry": geometry.name, "singular_depth": ds, "joint": joint_summary(jp),
+               "timings_seconds": st.timings, "files": files}
+    write_json(out / "summary.json", summary)
+    if not quiet:
+        sys.stdout.write(joint_table(jp) + "\n")
+    return 0
+
+
+def run_label(geometry_path, pose, depth: int, source=None, as_json: bool = False) -> int:
+    """``intervalkin label X Y PHI``: certified aspect, basic region and uniqueness domain of a pose."""
+    import json
+    from fractions import Fraction
+
+    from .geometry import geometry_from_option
+
+    try:
+        exact = [Fraction(str(v)) for v in pose]
+    except (ValueError, ZeroDivisionError):
+        raise InputError(f"pose: expected three numbers X Y PHI, got {' '.join(map(str, pose))}") from None
+    if source is not None:
+        res = _label_from_npz(Path(source), exact)
+    else:
+        geometry = geometry_from_option(geometry_path)
+        from .regions import label_pose
+
+        a = analyse(geometry, depth)
+        res = label_pose(a.regions, [str(v) for v in pose])
+    if as_json:
+        sys.stdout.write(json.dumps(res) + "\n")
+    else:
+        for k in ("in_workspace", "aspect", "basic_region", "uniqueness_domain"):
+            sys.stdout.write(f"{k:<18} {res[k]}\n")
+    return 0
+
+
+def _label_from_npz(folder: Path, exact) -> dict:
+    """Look a pose up in the workspace.npz of an earlier ``analyze`` / ``paper`` output."""
+    from fractions import Fraction
+
+    path = folder / "pavings" / "workspace.npz"
+    try:
+        with np.load(path) as z:
+            cols = {k: z[k] for k in ("lo", "hi", "in_workspace", "det_sign", "basic_region", "uniqueness_domain")}
+    except (OSError, KeyError, ValueError) as exc:
+        raise InputError(f"--from: cannot read {str(path)!r} ({exc})") from None
+    xf = np.array([float(v) for v in exact])
+    near = np.flatnonzero(np.all((cols["lo"] <= xf + 1e-9) & (xf - 1e-9 <= cols["hi"]), axis=1))
+    hit = [i for i in near if all(Fraction(float(cols["lo"][i, j])) <= exact[j] <= Fraction(float(cols["hi"][i, j]))
+                                  for j in range(3))]
+    res = {"pose": [str(v) for v in exact], "boxes": len(hit), "in_workspace": "undecided", "aspect": "undecided",
+           "basic_region": "undecided", "uniqueness_domain": "undecided"}
+    for i in hit:
+        w = int(cols["in_workspace"][i])
+        if w != 0:
+            res["in_workspace"] = "yes" if w > 0 else "no"
+        if w > 0 and cols["det_sign"][i] != 0:
+            res["aspect"] = "WA1" if cols["det_sign"][i] > 0 else "WA2"
+        if cols["basic_region"][i] >= 0:
+            res["basic_region"] = int(cols["basic_region"][i])
+        if cols["uniqueness_domain"][i] >= 0:
+            res["uniqueness_domain"] = int(cols["uniqueness_domain"][i])
+    if res["in_workspace"] == "no":
+        res["aspect"] = res["basic_region"] = res["uniqueness_domain"] = "none (outside W)"
+    return res

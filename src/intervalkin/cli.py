@@ -64,7 +64,35 @@ def _cmd_pave(args: argparse.Namespace) -> int:
     return run_pave(geometry_path=args.geometry, depth=args.depth, out=args.out)
 
 
+def _cmd_joint(args: argparse.Namespace) -> int:
+    from .analysis import run_joint
+
+    return run_joint(args.geometry, args.depth, args.out, force=args.force, quiet=args.quiet)
+
+
+def _cmd_analyze(args: argparse.Namespace) -> int:
+    from .analysis import run_analyze
+
+    return run_analyze(args.geometry, args.depth, args.out, force=args.force, quiet=args.quiet, as_json=args.json)
+
+
+def _cmd_paper(args: argparse.Namespace) -> int:
+    from .analysis import run_analyze
+
+    return run_analyze(None, args.depth, args.out, force=args.force, quiet=args.quiet, as_json=args.json, paper=True)
+
+
+def _cmd_label(args: argparse.Namespace) -> int:
+    from .analysis import run_label
+
+    return run_label(args.geometry, args.pose, args.depth, source=args.source, as_json=args.json)
+
+
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
+    "joint": _cmd_joint,
+    "analyze": _cmd_analyze,
+    "paper": _cmd_paper,
+    "label": _cmd_label,
     "dkp": _cmd_dkp,
     "table1": _cmd_table1,
     "pave": _cmd_pave,
@@ -90,6 +118,34 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--geometry", metavar="FILE")
     p.add_argument("--depth", type=int, default=6, metavar="N", help="octree depth (default 6)")
     p.add_argument("--out", default="intervalkin-pave", metavar="DIR", help="output folder")
+    from .analysis import DEFAULT_DEPTH
+
+    p = sub.add_parser("joint", help="joint space: enclosure of g(S) and cells of certified solution count")
+    p.add_argument("--geometry", metavar="FILE")
+    p.add_argument("--depth", type=int, default=6, metavar="N", help="2**N voxels per axis (default 6)")
+    p.add_argument("--out", default="intervalkin-joint", metavar="DIR", help="output folder")
+    p.add_argument("--force", action="store_true", help="write into a non-empty folder")
+    p.add_argument("--quiet", action="store_true", help="no progress, no table")
+
+    for name, text in (("analyze", "the whole chain for any geometry: aspects, basic regions, uniqueness domains"),
+                       ("paper", "regenerate the paper's results on its manipulator, with a report")):
+        p = sub.add_parser(name, help=text)
+        if name == "analyze":
+            p.add_argument("--geometry", metavar="FILE")
+        p.add_argument("--depth", type=int, default=DEFAULT_DEPTH, metavar="N",
+                       help=f"workspace octree depth (default {DEFAULT_DEPTH})")
+        p.add_argument("--out", default="intervalkin-paper" if name == "paper" else "intervalkin-analysis",
+                       metavar="DIR", help="output folder")
+        p.add_argument("--force", action="store_true", help="write into a non-empty folder that is not an earlier output")
+        p.add_argument("--quiet", action="store_true", help="no progress, no table")
+        p.add_argument("--json", action="store_true", help="print summary.json on stdout")
+
+    p = sub.add_parser("label", help="certified aspect, basic region and uniqueness domain of a pose")
+    p.add_argument("pose", nargs=3, metavar=("X", "Y", "PHI"), help="pose: B1 = (X, Y), angle PHI in radians")
+    p.add_argument("--geometry", metavar="FILE")
+    p.add_argument("--depth", type=int, default=7, metavar="N", help="depth of the analysis (default 7)")
+    p.add_argument("--from", dest="source", metavar="DIR", help="read the pavings of an earlier analyze/paper output")
+    p.add_argument("--json", action="store_true")
     return parser
 
 

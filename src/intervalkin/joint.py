@@ -370,3 +370,29 @@ def solution_count(geometry: Geometry, rho: Sequence, paving: JointPaving | None
         raise InputError(f"rho = {[float(v) for v in q]}: the solution count cannot be certified here (near g(S))")
     n1 = sum(1 for s in res.solutions if s.det_sign > 0)
     return len(res.solutions), n1, len(res.solutions) - n1, "solve"
+
+
+def pave_singular_layer(geometry: Geometry, depth: int, progress=None) -> np.ndarray:
+    """Workspace boxes (m, 3, 2) at ``depth`` covering every singular point of W.
+
+    A paving that splits only the boxes that may hold a singular point of W
+    (det A sign undecided and not certainly outside W): the layer is a surface,
+    so its size grows about 4x per level, not 8x.  Every other box is certified
+    free of singular points of W.
+    """
+    from .paving import Label, pave_multi, workspace_paving_domain
+    from .predicates import det_sign_predicate, workspace_predicate
+
+    def split(labels):
+        return (labels["W"] != Label.OUTSIDE) & (labels["det_positive"] == Label.BOUNDARY)
+
+    p = pave_multi(
+        workspace_paving_domain(geometry),
+        [("W", workspace_predicate(geometry)), ("det_positive", det_sign_predicate(geometry))],
+        depth,
+        split=split,
+        relevant={"det_positive": lambda labels: labels["W"] != Label.OUTSIDE},
+        progress=progress,
+    )
+    sel = split(p.labels)
+    return p.boxes[sel]

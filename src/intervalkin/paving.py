@@ -49,6 +49,7 @@ dyadic square contains the other, so each face looks up its ancestors' keys
 from __future__ import annotations
 
 import enum
+import functools
 import math
 import os
 import time
@@ -194,6 +195,15 @@ class Paving:
         return Paving(self.domain, self.depth, self.level[mask], self.ijk[mask], self.lo[mask], self.hi[mask],
                       {k: v[mask] for k, v in self.labels.items()}, list(self.stats))
 
+    @functools.cached_property
+    def _sorted_keys(self) -> tuple[np.ndarray, np.ndarray]:
+        """Sorted integer keys (level, i, j, k) of the leaves and the sorting order (built once)."""
+        nb = self.depth + 1
+        level = self.level.astype(np.int64)
+        keys = (level << (3 * nb)) | (self.ijk[:, 0] << (2 * nb)) | (self.ijk[:, 1] << nb) | self.ijk[:, 2]
+        order = np.argsort(keys)
+        return keys[order], order
+
     def locate_boxes(self, boxes: np.ndarray) -> np.ndarray:
         """Index of the leaf that contains each query box (m, 3, 2) entirely, or -1.
 
@@ -210,11 +220,8 @@ class Paving:
         nfine = np.int64(1) << self.depth
         t = (boxes[:, :, 0] - self.domain[:, 0]) / width * nfine
         fine = np.clip(np.floor(t), 0, nfine - 1).astype(np.int64)
-        level = self.level.astype(np.int64)
         nb = self.depth + 1
-        keys = (level << (3 * nb)) | (self.ijk[:, 0] << (2 * nb)) | (self.ijk[:, 1] << nb) | self.ijk[:, 2]
-        order = np.argsort(keys)
-        sk = keys[order]
+        sk, order = self._sorted_keys
         for L in range(self.depth + 1):
             c = fine >> (self.depth - L)
             qk = (np.int64(L) << (3 * nb)) | (c[:, 0] << (2 * nb)) | (c[:, 1] << nb) | c[:, 2]
