@@ -290,6 +290,8 @@ def prepare_output_dir(out, force: bool) -> Path:
         raise InputError(f"--out: {str(out)!r} is not empty and not an intervalkin output (use --force to write there)")
     try:
         out.mkdir(parents=True, exist_ok=True)
+        for stale in out.rglob(".*.tmp"):  # left by a run that was killed outright
+            stale.unlink()
         probe = out / f".{MARKER}.probe"
         probe.write_bytes(b"")
         probe.unlink()
@@ -415,9 +417,10 @@ def _write_certificates(a: Analysis, out: Path) -> list[str]:
 
     dkp_results = []
     if a.geometry.name == "Wenger-Chablat 1997":
+        from .dkp import parse_joint_vector
         from .paper import TABLE1_RHO
 
-        dkp_results.append(solve(a.geometry, TABLE1_RHO))
+        dkp_results.append(solve(a.geometry, parse_joint_vector(a.geometry, TABLE1_RHO)))
     paths = write_certificates(out / "certificates", a.geometry, dkp_results=dkp_results, joint=a.joint,
                                regions=a.regions)
     return [f"certificates/{Path(p).name}" for p in paths]

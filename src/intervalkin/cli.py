@@ -88,6 +88,21 @@ def _cmd_label(args: argparse.Namespace) -> int:
     return run_label(args.geometry, args.pose, args.depth, source=args.source, as_json=args.json)
 
 
+def _cmd_trajectory(args: argparse.Namespace) -> int:
+    from .geometry import geometry_from_option
+    from .trajectory import trajectory_with_regions, write_trajectory
+
+    geometry = geometry_from_option(args.geometry)
+    traj, ra, jp = trajectory_with_regions(geometry, args.rho, args.i_from, args.i_to, depth=args.depth)
+    if args.out:
+        write_trajectory(traj, geometry, args.out, paving=ra.paving, joint=jp)
+    if args.json:
+        _print_json(traj.to_json())
+    else:
+        sys.stdout.write(traj.summary() + "\n")
+    return 0
+
+
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "joint": _cmd_joint,
     "analyze": _cmd_analyze,
@@ -96,6 +111,7 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "dkp": _cmd_dkp,
     "table1": _cmd_table1,
     "pave": _cmd_pave,
+    "trajectory": _cmd_trajectory,
 }
 
 
@@ -146,12 +162,32 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--depth", type=int, default=7, metavar="N", help="depth of the analysis (default 7)")
     p.add_argument("--from", dest="source", metavar="DIR", help="read the pavings of an earlier analyze/paper output")
     p.add_argument("--json", action="store_true")
+
+    p = sub.add_parser("trajectory", help="certified non-singular motion between two solutions of one aspect")
+    p.add_argument("--rho", nargs=3, required=True, metavar=("R1", "R2", "R3"), help="leg lengths (exact decimals)")
+    p.add_argument("--from", dest="i_from", type=int, required=True, metavar="I", help="start solution (as `dkp` numbers it)")
+    p.add_argument("--to", dest="i_to", type=int, required=True, metavar="J", help="goal solution")
+    p.add_argument("--geometry", metavar="FILE")
+    p.add_argument("--depth", type=int, default=7, metavar="N", help="workspace octree depth (default 7)")
+    p.add_argument("--out", metavar="DIR", help="write trajectory.json and the figures here")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
     return parser
 
 
+def _terminate(signum, frame):  # pragma: no cover - exercised through a subprocess test
+    # SIGTERM becomes an exception, so atomic writers remove their temporary files
+    raise SystemExit(128 + signum)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    import signal
+
     parser = build_parser()
     args = parser.parse_args(argv)
+    try:
+        signal.signal(signal.SIGTERM, _terminate)
+    except ValueError:  # not the main thread (e.g. called from a test runner thread)
+        pass
     try:
         return _COMMANDS[args.command](args)
     except IntervalkinError as exc:

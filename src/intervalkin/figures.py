@@ -53,7 +53,7 @@ def render_3d(paving: Paving, layers, path, title: str, max_points: int = 40000,
         if idx.size == 0:
             continue
         s = np.clip(w[idx] * 10.0, 3.0, 80.0)
-        ax.scatter(c[idx, 0], c[idx, 1], c[idx, 2], s=s, c=colour, alpha=0.55, linewidths=0,
+        ax.scatter(c[idx, 0], c[idx, 1], c[idx, 2], s=s, color=colour, alpha=0.55, linewidths=0,
                    label=f"{name} ({np.count_nonzero(mask)} boxes)", depthshade=True)
     ax.set_xlabel("x")
     ax.set_ylabel("y")
@@ -209,7 +209,8 @@ def render_joint(joint, out_dir, max_points: int = 60000, seed: int = 0) -> list
     for k in (2, 4, 6):
         idx = _subsample(np.flatnonzero(count == k), max_points // 3, rng)
         if idx.size:
-            ax.scatter(*centre[idx].T, s=2, c=_COUNT_COLOURS[k], alpha=0.35, linewidths=0,
+            ax.scatter(*centre[idx].T, s={2: 1, 4: 2, 6: 4}[k], c=_COUNT_COLOURS[k],
+                       alpha={2: 0.06, 4: 0.2, 6: 0.6}[k], linewidths=0,
                        label=f"{k} solutions ({np.count_nonzero(count == k)} voxels)")
     ax.set_xlabel("rho1")
     ax.set_ylabel("rho2")

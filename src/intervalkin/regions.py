@@ -191,7 +191,13 @@ class RegionAnalysis:
 
     @property
     def consistent(self) -> bool:
-        return all(c["sheets_with_boxes"] == c["expected"] and c["unassigned_pieces"] == 0 for c in self.consistency)
+        """Every sheet above every realized cell holds certified boxes (Proposition 1 seen in full)."""
+        return all(c["sheets_with_boxes"] == c["expected"] for c in self.consistency)
+
+    @property
+    def unplaced_regions(self) -> tuple[int, ...]:
+        """Regions with no certified box at this depth (left out of the uniqueness domains)."""
+        return tuple(r.id for r in self.regions if r.n_boxes == 0)
 
     def counts(self) -> dict:
         """The counts with their certification status (the summary.json schema)."""
@@ -232,7 +238,10 @@ class RegionAnalysis:
                     "over the aspects); the partition found "
                     + ("reaches this bound" if len(self.domains) == self.domains_lower_bound else "exceeds it")
                     + "; it relies on region adjacency across the undecided layer, which is heuristic"
+                    + (f"; regions {list(self.unplaced_regions)} have no certified box at this depth and are not "
+                       "placed in any domain" if self.unplaced_regions else "")
                 ),
+                "unplaced_regions": list(self.unplaced_regions),
             },
         }
 
@@ -565,7 +574,9 @@ def analyse_regions(geometry: Geometry, joint: JointPaving, depth: int, progress
     unrealized = tuple(c.id for c in joint.cells if c.count > 0 and c.id not in realized)
 
     adjacency = region_adjacency(paving, edges, region)
-    groups, bound = uniqueness_domains(regions, adjacency)
+    # regions without certified boxes at this depth cannot be placed (no adjacency is known)
+    groups, _ = uniqueness_domains([r for r in regions if r.n_boxes > 0], adjacency)
+    bound = sum(max((r.sheet + 1 for r in regions if r.aspect == name), default=0) for name in ASPECTS)
     lookup = np.full(len(regions) + 1, -1, dtype=np.int32)
     for gi, grp in enumerate(groups):
         lookup[list(grp)] = gi

@@ -1,0 +1,125 @@
+"""The whole chain from the command line: outputs, their schema, bad input, interrupted runs."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from intervalkin.cli import main
+
+
+@pytest.fixture(scope="module")
+def analysed(tmp_path_factory):
+    out = tmp_path_factory.mktemp("analysis")
+    status = main(["analyze", "--depth", "5", "--out", str(out), "--quiet", "--force"])
+    assert status == 0
+    return out
+
+
+def test_outputs_and_summary_schema(analysed):
+    s = json.loads((analysed / "summary.json").read_text())
+    assert s["aspects"]["count"] == 2 and s["aspects"]["lower_bound"] == 2
+    for key in ("basic_regions", "uniqueness_domains"):
+        assert {"count", "exact", "lower_bound"} <= set(s[key])
+        assert s[key]["lower_bound"] <= max(s[key]["count"], s[key]["lower_bound"])
+    with np.load(analysed / "pavings" / "workspace.npz") as z:
+        assert {"lo", "hi", "depth", "in_workspace", "det_sign", "aspect", "basic_region", "uniqueness_domain"} <= set(z.files)
+        n = z["lo"].shape[0]
+        assert z["basic_region"].shape == (n,) and z["uniqueness_domain"].dtype == np.int32
+        # a box with a region is certified inside an aspect
+        br = z["basic_region"] >= 0
+        assert np.all(z["in_workspace"][br] == 1) and np.all(z["det_sign"][br] != 0)
+    with np.load(analysed / "pavings" / "joint.npz") as z:
+        assert set(z.files) == {"lo", "hi", "cell", "count", "n_wa1", "n_wa2"}
+    assert (analysed / "pavings" / "workspace.vtu").exists()
+    assert all((analysed / f).exists() for f in s["files"])
+
+
+def test_json_prints_one_object(tmp_path, capsys):
+    assert main(["analyze", "--depth", "4", "--out", str(tmp_path / "o"), "--quiet", "--json"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("\n") == 1
+    assert json.loads(out)["aspects"]["count"] == 2
+
+
+def test_refuses_a_foreign_non_empty_folder(tmp_path, capsys):
+    d = tmp_path / "mine"
+    d.mkdir()
+    (d / "thesis.tex").write_text("precious")
+    assert main(["analyze", "--depth", "4", "--out", str(d), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--force" in err
+    assert (d / "thesis.tex").read_text() == "precious"
+
+
+@pytest.mark.parametrize(
+    "argv,fragment",
+    [
+        (["analyze", "--depth", "0"], "--depth"),
+        (["analyze", "--depth", "40"], "--depth"),
+        (["analyze", "--geometry", "/nonexistent.toml"], "not found"),
+        (["joint", "--depth", "12"], "--depth"),
+        (["label", "1", "2", "x", "--from", "/nonexistent"], "pose"),
+    ],
+)
+def test_bad_input_one_line_status_2(tmp_path, capsys, argv, fragment):
+    assert main(argv + ["--out", str(tmp_path / "o")] if argv[0] != "label" else argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and fragment in err and "Traceback" not in err
+
+
+def test_unwritable_out(tmp_path, capsys):
+    f = tmp_path / "afile"
+    f.write_text("x")
+    assert main(["analyze", "--depth", "4", "--out", str(f / "sub"), "--quiet"]) == 2
+    assert "--out" in capsys.readouterr().err
+
+
+def test_interrupted_run_leaves_no_partial_file(tmp_path):
+    """SIGTERM in the middle of a run: every file present is complete, no temporary file is left."""
+    out = tmp_path / "run"
+    env = dict(os.environ)
+    proc = subprocess.Popen([sys.executable, "-m", "intervalkin.cli", "analyze", "--depth", "6", "--out", str(out),
+                             "--quiet"], env=env, stderr=subprocess.PIPE, stdout=subprocess.PIPE)
+    # wait until the run has started writing, then stop it
+    deadline = time.time() + 120
+    while time.time() < deadline and not (out / "pavings").exists():
+        time.sleep(0.05)
+    time.sleep(0.3)
+    proc.send_signal(signal.SIGTERM)
+    proc.wait(timeout=60)
+    assert proc.returncode != 0
+    leftovers = [p for p in out.rglob("*") if p.name.endswith(".tmp")]
+    assert leftovers == []
+    for p in out.rglob("*.npz"):
+        with np.load(p) as z:
+            assert z.files
+    for p in out.rglob("*.json"):
+        json.loads(p.read_text())
+    # a second run is not confused by the first
+    assert main(["analyze", "--depth", "4", "--out", str(out), "--quiet"]) == 0
+
+
+def test_label_from_an_earlier_output(analysed, capsys):
+    assert main(["label", "-5.495660815453", "-13.935498276039", "-0.047331369367", "--from", str(analysed),
+                 "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["in_workspace"] in ("yes", "undecided")
+    assert res["aspect"] in ("WA1", "undecided")
+    assert main(["label", "60", "60", "0", "--from", str(analysed), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["boxes"] == 0
+
+
+def test_joint_command(tmp_path, capsys):
+    assert main(["joint", "--depth", "4", "--out", str(tmp_path / "j")]) == 0
+    s = json.loads((tmp_path / "j" / "summary.json").read_text())
+    counts = {c["count"] for c in s["joint"]["cells"]}
+    assert {2, 4} <= counts
+    assert "count" in capsys.readouterr().out
