@@ -102,3 +102,21 @@ def test_json_atomic(tmp_path):
         write_json(path, {"a": float("nan")})
     assert json.loads(path.read_text()) == {"a": 1, "b": [1.5, 2]}  # failed write left the old file
     assert os.listdir(tmp_path) == ["summary.json"]
+
+
+def test_vtu_with_shared_points(tmp_path):
+    """Shared corners: fewer points than 8 per box, every cell's corners are its box's corners."""
+    from intervalkin.export import write_vtu_paving
+
+    g = default_geometry()
+    p = pave_workspace(g, 4)
+    mask = p.labels["W"] != Label.OUTSIDE
+    path = write_vtu_paving(tmp_path / "s.vtu", p, {"depth": p.level}, mask=mask)
+    v = read_vtu(path)
+    n = int(mask.sum())
+    assert v["NumberOfCells"] == n and v["NumberOfPoints"] < 8 * n
+    conn = v["connectivity"].reshape(n, 8)
+    pts = v["points"][conn]
+    sel = np.flatnonzero(mask)
+    assert np.array_equal(pts.min(axis=1), p.lo[sel]) and np.array_equal(pts.max(axis=1), p.hi[sel])
+    assert np.array_equal(v["depth"], p.level[sel])

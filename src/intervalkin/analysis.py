@@ -115,7 +115,7 @@ def run_pave(geometry_path, depth, out, figures: bool = True, progress: bool = T
     Validates ``depth`` (integer 1..MAX_DEPTH, memory estimate against
     MemAvailable) before any work; returns the exit status 0.
     """
-    from .export import paving_columns, write_json, write_npz, write_vtu
+    from .export import paving_columns, write_json, write_npz, write_vtu_paving
     from .geometry import geometry_from_option
     from .predicates import aspect_components, pave_workspace
 
@@ -132,8 +132,9 @@ def run_pave(geometry_path, depth, out, figures: bool = True, progress: bool = T
     t2 = time.perf_counter()
     write_npz(out / "pavings" / "workspace.npz", paving, aspect)
     cols = paving_columns(paving, aspect)
-    write_vtu(out / "pavings" / "workspace.vtu", paving.lo, paving.hi,
-              {k: cols[k] for k in ("in_workspace", "det_sign", "aspect", "depth")})
+    write_vtu_paving(out / "pavings" / "workspace.vtu", paving,
+                     {k: cols[k] for k in ("in_workspace", "det_sign", "aspect", "depth")},
+                     mask=paving.labels["W"] != Label.OUTSIDE)
     t3 = time.perf_counter()
     fig_files = []
     if figures:
@@ -305,7 +306,7 @@ def prepare_output_dir(out, force: bool) -> Path:
 
 def write_chain(a: Analysis, out: Path, figures: bool = True, stages: Stages | None = None) -> dict:
     """Write pavings (npz, VTK), figures and summary.json of an analysis; returns the summary."""
-    from .export import atomic_write_bytes, paving_columns, write_json, write_npz, write_vtu
+    from .export import atomic_write_bytes, paving_columns, write_json, write_npz, write_vtu_paving
 
     st = stages or Stages(quiet=True)
     ra = a.regions
@@ -314,8 +315,10 @@ def write_chain(a: Analysis, out: Path, figures: bool = True, stages: Stages | N
     extra = {"basic_region": ra.region.astype(np.int32), "uniqueness_domain": ra.domain.astype(np.int32)}
     write_npz(out / "pavings" / "workspace.npz", p, ra.aspect, extra)
     cols = paving_columns(p, ra.aspect, extra)
-    write_vtu(out / "pavings" / "workspace.vtu", p.lo, p.hi,
-              {k: cols[k] for k in ("in_workspace", "det_sign", "aspect", "basic_region", "uniqueness_domain", "depth")})
+    write_vtu_paving(out / "pavings" / "workspace.vtu", p,
+                     {k: cols[k] for k in ("in_workspace", "det_sign", "aspect", "basic_region", "uniqueness_domain",
+                                           "depth")},
+                     mask=p.labels["W"] != Label.OUTSIDE)
     jc = a.joint.columns()
     atomic_write_bytes(out / "pavings" / "joint.npz", _npz_bytes(jc))
     st.done()

@@ -40,6 +40,7 @@ __all__ = [
     "write_json",
     "write_vtu",
     "read_vtu",
+    "write_vtu_paving",
     "write_vtk_legacy",
     "NPZ_COLUMNS",
 ]
@@ -168,6 +169,47 @@ def write_vtu(path, lo: np.ndarray, hi: np.ndarray, cell_data: Mapping[str, np.n
     for name, arr in cell_data.items():
         out.append(f'<DataArray type="Int32" Name="{name}" format="binary">\n')
         out.append(_b64(np.asarray(arr).astype("<i4")))
+        out.append("\n</DataArray>\n")
+    out.append("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")
+    return atomic_write_bytes(path, "".join(out).encode())
+
+
+def write_vtu_paving(path, paving: Paving, cell_data: Mapping[str, np.ndarray], mask=None) -> Path:
+    """.vtu of the selected boxes of a paving, hexahedra sharing their corner points.
+
+    Corners are identified by their integer coordinates at the paving's depth,
+    so neighbouring boxes share points (about one point per box instead of
+    eight) and connectivity is Int32: a file about a quarter of the size of
+    :func:`write_vtu`.  Corner coordinates are the same floats as the box bounds.
+    """
+    sel = np.arange(len(paving)) if mask is None else np.flatnonzero(mask)
+    flo, fhi = paving.fine_coordinates()
+    flo, fhi = flo[sel], fhi[sel]
+    nf = np.int64(1) << paving.depth
+    corners = np.stack([np.where(_HEX[None, :, a] == 0, flo[:, None, a], fhi[:, None, a]) for a in range(3)], axis=-1)
+    keys = (corners[..., 0] * (nf + 1) + corners[..., 1]) * (nf + 1) + corners[..., 2]
+    uniq, inverse = np.unique(keys.ravel(), return_inverse=True)
+    k = np.stack([uniq // ((nf + 1) * (nf + 1)), (uniq // (nf + 1)) % (nf + 1), uniq % (nf + 1)], axis=1)
+    dom = np.asarray(paving.domain, dtype=np.float64)
+    step = np.ldexp(dom[:, 1] - dom[:, 0], -paving.depth)
+    pts = np.where(k == nf, dom[:, 1], dom[:, 0] + k * step).astype("<f8")
+    n = sel.size
+    out = [
+        '<?xml version="1.0"?>\n',
+        '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n',
+        f'<UnstructuredGrid>\n<Piece NumberOfPoints="{len(pts)}" NumberOfCells="{n}">\n',
+        '<Points>\n<DataArray type="Float64" NumberOfComponents="3" format="binary">\n',
+        _b64(pts), "\n</DataArray>\n</Points>\n<Cells>\n",
+        '<DataArray type="Int32" Name="connectivity" format="binary">\n',
+        _b64(inverse.astype("<i4")), "\n</DataArray>\n",
+        '<DataArray type="Int32" Name="offsets" format="binary">\n',
+        _b64(8 * np.arange(1, n + 1, dtype="<i4")), "\n</DataArray>\n",
+        '<DataArray type="UInt8" Name="types" format="binary">\n',
+        _b64(np.full(n, 12, dtype=np.uint8)), "\n</DataArray>\n</Cells>\n<CellData>\n",
+    ]
+    for name, arr in cell_data.items():
+        out.append(f'<DataArray type="Int32" Name="{name}" format="binary">\n')
+        out.append(_b64(np.asarray(arr)[sel].astype("<i4")))
         out.append("\n</DataArray>\n")
     out.append("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")
     return atomic_write_bytes(path, "".join(out).encode())
