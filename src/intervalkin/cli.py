@@ -103,6 +103,17 @@ def _cmd_trajectory(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_verify(args: argparse.Namespace) -> int:
+    from .checker import verify_directory
+
+    results = verify_directory(args.dir)
+    for r in results:
+        sys.stdout.write(r.line() + "\n")
+    failed = sum(1 for r in results if not r.verified)
+    sys.stderr.write(f"{len(results) - failed} of {len(results)} claims verified\n")
+    return 1 if failed else 0
+
+
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "joint": _cmd_joint,
     "analyze": _cmd_analyze,
@@ -112,6 +123,7 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "table1": _cmd_table1,
     "pave": _cmd_pave,
     "trajectory": _cmd_trajectory,
+    "verify": _cmd_verify,
 }
 
 
@@ -171,6 +183,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--depth", type=int, default=7, metavar="N", help="workspace octree depth (default 7)")
     p.add_argument("--out", metavar="DIR", help="write trajectory.json and the figures here")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("verify", help="re-check a certificate folder with the independent checker (arb only)")
+    p.add_argument("dir", metavar="DIR", help="folder holding index.json and the claim files")
     return parser
 
 

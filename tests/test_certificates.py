@@ -1,0 +1,360 @@
+"""Certificates and the independent checker: honest files verify, tampered files are refused."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import subprocess
+import sys
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+from flint import ctx
+
+from intervalkin import checker
+from intervalkin.certificates import write_certificates
+from intervalkin.cli import main
+from intervalkin.dkp import _poly_t, _reduce, approx_solve, parse_joint_vector, solve
+from intervalkin.joint import joint_paving
+from intervalkin.paving import Label
+from intervalkin.predicates import pave_workspace
+from intervalkin.regions import analyse_regions
+
+TABLE1 = ["14.98", "15.38", "12.0"]
+
+
+@pytest.fixture(scope="module")
+def table1(paper_geometry):
+    return solve(paper_geometry, parse_joint_vector(paper_geometry, TABLE1))
+
+
+@pytest.fixture(scope="module")
+def chain(paper_geometry):
+    """A small real chain (about 15 s): workspace depth 7, joint grid 2**5, regions at depth 7."""
+    p = pave_workspace(paper_geometry, 7)
+    sel = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
+    jp = joint_paving(paper_geometry, p.boxes[sel], 5)
+    ra = analyse_regions(paper_geometry, jp, 7)
+    return jp, ra
+
+
+@pytest.fixture(scope="module")
+def cert_dir(tmp_path_factory, paper_geometry, chain, table1):
+    jp, ra = chain
+    out = tmp_path_factory.mktemp("certificates")
+    write_certificates(out, paper_geometry, dkp_results=[table1], joint=jp, regions=ra, box_sample=120, seed=7)
+    return out
+
+
+def _copy(src: Path, tmp_path: Path) -> Path:
+    dst = tmp_path / "copy"
+    shutil.copytree(src, dst)
+    return dst
+
+
+def _load(d: Path, name: str) -> dict:
+    return json.loads((d / name).read_text())
+
+
+def _save(d: Path, name: str, doc: dict) -> None:
+    (d / name).write_text(json.dumps(doc, indent=1))
+
+
+def _failed(d: Path) -> list[checker.CheckResult]:
+    return [r for r in checker.verify_directory(d) if not r.verified]
+
+
+def _refused(d: Path, capsys, file: str, claim: str | None = None) -> str:
+    """Assert the CLI exits 1 and prints a FAILED line for the claim; return that line."""
+    bad = _failed(d)
+    assert any(r.file == file and (claim is None or r.claim == claim) for r in bad), [r.line() for r in bad]
+    assert main(["verify", str(d)]) == 1
+    out = capsys.readouterr().out
+    lines = [ln for ln in out.splitlines() if ln.startswith(f"FAILED: {file}#{claim or ''}")]
+    assert lines, out
+    return lines[0]
+
+
+# --------------------------------------------------------------------------------------
+# Honest certificates
+# --------------------------------------------------------------------------------------
+def test_every_claim_of_the_chain_verifies(cert_dir, capsys):
+    results = checker.verify_directory(cert_dir)
+    assert results and all(r.verified for r in results), [r.line() for r in results if not r.verified]
+    kinds = {r.kind for r in results}
+    assert kinds == set(checker.KINDS)
+    assert main(["verify", str(cert_dir)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == len(results) and all(ln.startswith("verified: ") for ln in out)
+
+
+def test_counts_are_backed_by_the_claims(cert_dir, chain):
+    _, ra = chain
+    declared = {c["name"]: c for c in _load(cert_dir, "counts.json")["claims"]}
+    counts = ra.counts()
+    for name in ("aspects", "basic_regions", "uniqueness_domains"):
+        assert declared[name]["lower_bound"] == counts[name]["lower_bound"]
+        assert declared[name]["exact"] is False and declared[name]["support"]
+    # the paper's six-solution cells: three solutions of each aspect
+    assert declared["uniqueness_domains"]["lower_bound"] == 6
+
+
+def test_table1_alone(tmp_path, paper_geometry, table1):
+    paths = write_certificates(tmp_path, paper_geometry, dkp_results=[table1])
+    assert [p.name for p in paths] == ["dkp.json", "index.json"]
+    (r,) = checker.verify_directory(tmp_path)
+    assert r.verified and "exactly 6 solutions (3 with det A > 0, 3 with det A < 0)" in r.message
+    claim = _load(tmp_path, "dkp.json")["claims"][0]
+    assert claim["rho"] == ["749/50", "769/50", "12/1"] and claim["complete"] is True
+    assert max(b[1] - b[0] for s in claim["solutions"] for b in s["box"]) < 1e-9
+
+
+def test_files_written_atomically_and_index_last(cert_dir):
+    index = _load(cert_dir, "index.json")
+    assert index["format"] == "intervalkin-certificate" and index["version"] == 1
+    assert sorted(index["files"]) == sorted(f"{k}.json" for k in checker.KINDS)
+    assert not list(cert_dir.glob(".*.tmp"))
+    for name in index["files"]:
+        doc = _load(cert_dir, name)
+        assert doc["geometry_toml"] == index["geometry_toml"]
+
+
+def test_sample_indices_reproducible_and_distinct():
+    a = checker.sample_indices(3, 1000, 50)
+    assert a == checker.sample_indices(3, 1000, 50)
+    assert len(set(a)) == 50 and all(0 <= i < 1000 for i in a)
+    assert checker.sample_indices(4, 1000, 50) != a
+    assert sorted(checker.sample_indices(0, 5, 10)) == [0, 1, 2, 3, 4]
+
+
+def test_reduced_sextic_agrees_with_the_solver_derivation(paper_geometry, rng):
+    """The checker's real-polynomial derivation and dkp's Laurent one give overlapping coefficients."""
+    for _ in range(5):
+        rho = [Fraction(int(rng.integers(1000, 3200)), 100) for _ in range(3)]
+        for phi0 in (0.0, round(math.pi / 6, 6)):
+            with ctx.workprec(128):
+                rs = [checker._q(r * r) for r in rho]
+                mine = checker._reduced_sextic(checker._Model(paper_geometry), rs, phi0)
+                theirs = _poly_t(_reduce(paper_geometry, rs), phi0)
+            assert all(a.overlaps(b) for a, b in zip(mine, theirs))
+
+
+def test_checker_root_count_agrees_with_float_solver(paper_geometry, rng):
+    """The checker's certified count against an independent float solver that samples phi densely."""
+    done = 0
+    while done < 12:
+        rho = [Fraction(int(rng.integers(1000, 3200)), 100) for _ in range(3)]
+        with ctx.workprec(128):
+            rs = [checker._q(r * r) for r in rho]
+            try:
+                n = checker._count_solutions(checker._Model(paper_geometry), rs, 0.0, 512)
+            except checker._Refused:
+                continue
+        assert n == len(approx_solve(paper_geometry, [float(r) for r in rho]))
+        done += 1
+
+
+def test_box_label_refused_when_false(paper_geometry, cert_dir):
+    """A box straddling det A = 0 cannot be re-proved with either sign."""
+    doc = _load(cert_dir, "region_distinct.json")
+    b = doc["claims"][0]["solutions"][0]["paving_box"]["box"]
+    assert checker.box_label_proved(paper_geometry, b, "W", 2)
+    assert checker.box_label_proved(paper_geometry, b, "W", 1) is False
+    wide = [[-2.0, 2.0], [-2.0, 2.0], [-3.0, 3.0]]  # around A1: rho_1 < 10, outside W
+    assert checker.box_label_proved(paper_geometry, wide, "W", 1)
+    assert checker.box_label_proved(paper_geometry, wide, "W", 2) is False
+    assert checker.box_label_proved(paper_geometry, wide, "det_positive", 3) is None
+
+
+# --------------------------------------------------------------------------------------
+# Tampering: each change must be refused (FAILED, exit status 1)
+# --------------------------------------------------------------------------------------
+def _bump_digit(text: str) -> str:
+    """Change the last digit of the numerator of "p/q" (by +1, 9 -> 8)."""
+    num, den = text.split("/")
+    d = int(num[-1])
+    return num[:-1] + str(d + 1 if d < 9 else d - 1) + "/" + den
+
+
+def test_tamper_witness_digit_of_joint_cell(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "joint_cell.json")
+    claim = next(c for c in doc["claims"] if c["count"] > 0)
+    claim["witness"][0] = _bump_digit(claim["witness"][0])
+    _save(d, "joint_cell.json", doc)
+    line = _refused(d, capsys, "joint_cell.json", claim["id"])
+    assert "Krawczyk" in line or "real roots" in line
+
+
+def test_tamper_witness_digit_of_region_claim(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "region_distinct.json")
+    doc["claims"][0]["rho"][2] = _bump_digit(doc["claims"][0]["rho"][2])
+    _save(d, "region_distinct.json", doc)
+    assert "Krawczyk" in _refused(d, capsys, "region_distinct.json", doc["claims"][0]["id"])
+
+
+def test_tamper_dkp_joint_vector_digit(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "dkp.json")
+    doc["claims"][0]["rho"][1] = "770/50"
+    _save(d, "dkp.json", doc)
+    _refused(d, capsys, "dkp.json", "q-0")
+
+
+def test_tamper_box_bound_moved_off_the_solution(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "dkp.json")
+    lo, hi = doc["claims"][0]["solutions"][2]["box"][0]
+    doc["claims"][0]["solutions"][2]["box"][0][1] = lo + (hi - lo) / 4  # the upper x bound only
+    _save(d, "dkp.json", doc)
+    assert "Krawczyk" in _refused(d, capsys, "dkp.json", "q-0")
+
+
+def test_tamper_box_bound_digit_makes_it_empty(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "dkp.json")
+    box = doc["claims"][0]["solutions"][0]["box"]
+    s = repr(box[1][0])
+    k = s.index(".") + 1  # first decimal digit: moves the bound by 0.1, past the other one
+    up = box[1][0] >= 0
+    box[1][0] = float(s[:k] + str((int(s[k]) + 1) % 10 if up else (int(s[k]) - 1) % 10) + s[k + 1:])
+    _save(d, "dkp.json", doc)
+    assert "empty interval" in _refused(d, capsys, "dkp.json", "q-0")
+
+
+def test_tamper_paving_box_bound(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "region_distinct.json")
+    sol = doc["claims"][0]["solutions"][0]
+    sol["paving_box"]["box"][2][0] = sol["box"][2][1]  # the paving box no longer holds the solution box
+    _save(d, "region_distinct.json", doc)
+    assert "not inside the stated paving box" in _refused(d, capsys, "region_distinct.json", doc["claims"][0]["id"])
+
+
+@pytest.mark.parametrize("name, bump", [("aspects", 1), ("basic_regions", None), ("uniqueness_domains", 1)])
+def test_tamper_declared_count(cert_dir, tmp_path, capsys, name, bump):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "counts.json")
+    claim = next(c for c in doc["claims"] if c["name"] == name)
+    # just above what the evidence supports (12 basic regions: 2 + 4 + 6 solutions of the three splits)
+    claim["lower_bound"] = (claim["lower_bound"] + bump) if bump else 13
+    _save(d, "counts.json", doc)
+    assert "exceeds" in _refused(d, capsys, "counts.json", name)
+
+
+def test_tamper_joint_cell_count_and_exact_claim(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "joint_cell.json")
+    claim = next(c for c in doc["claims"] if c["count"] == 4)
+    claim["count"] = 6
+    _save(d, "joint_cell.json", doc)
+    counts = _load(d, "counts.json")
+    counts["claims"][1]["exact"] = True
+    _save(d, "counts.json", counts)
+    assert "declared count" in _refused(d, capsys, "joint_cell.json", claim["id"])
+    assert "upper bound" in _refused(d, capsys, "counts.json", counts["claims"][1]["id"])
+
+
+def test_tamper_det_sign(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "dkp.json")
+    s = doc["claims"][0]["solutions"][1]
+    s["det_sign"] = -s["det_sign"]
+    _save(d, "dkp.json", doc)
+    assert "det A is not proved" in _refused(d, capsys, "dkp.json", "q-0")
+
+
+def test_tamper_aspect_and_box_label(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "aspect_distinct.json")
+    doc["claims"][0]["boxes"][0]["aspect"] = "WA2"
+    _save(d, "aspect_distinct.json", doc)
+    labels = _load(d, "box_labels.json")
+    item = next(b for b in labels["claims"][0]["boxes"] if b["labels"]["W"] in (1, 2))
+    item["labels"]["W"] = 3 - item["labels"]["W"]  # INSIDE <-> OUTSIDE
+    _save(d, "box_labels.json", labels)
+    _refused(d, capsys, "aspect_distinct.json", "aspects")
+    assert f"box index {item['index']}" in _refused(d, capsys, "box_labels.json", "sample")
+
+
+def test_tamper_hand_picked_sample(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "box_labels.json")
+    doc["claims"][0]["boxes"][0]["index"] += 1
+    _save(d, "box_labels.json", doc)
+    assert "seed" in _refused(d, capsys, "box_labels.json", "sample")
+
+
+def test_tamper_geometry_decimal_everywhere(cert_dir, tmp_path, capsys):
+    """A2 = (15.91, 0) -> (15.92, 0) in every file: the solutions no longer solve, counts lose support."""
+    d = _copy(cert_dir, tmp_path)
+    for f in d.glob("*.json"):
+        text = f.read_text()
+        assert "15.91" in text
+        f.write_text(text.replace("15.91", "15.92"))
+    bad = {(r.file, r.claim) for r in _failed(d)}
+    assert ("dkp.json", "q-0") in bad and ("counts.json", "basic_regions") in bad
+    assert all(("joint_cell.json", c["id"]) in bad for c in _load(d, "joint_cell.json")["claims"] if c["count"] > 0)
+    assert main(["verify", str(d)]) == 1
+    capsys.readouterr()
+
+
+def test_tamper_geometry_decimal_in_one_file(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "box_labels.json")
+    doc["geometry_toml"] = doc["geometry_toml"].replace("15.91", "15.92")
+    _save(d, "box_labels.json", doc)
+    assert "geometry differs" in _refused(d, capsys, "box_labels.json", "sample")
+
+
+def test_tamper_dropped_solution_breaks_completeness(cert_dir, tmp_path, capsys):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "dkp.json")
+    doc["claims"][0]["solutions"].pop()
+    doc["claims"][0]["count"] = 5
+    _save(d, "dkp.json", doc)
+    assert "6 real roots but 5 solution boxes" in _refused(d, capsys, "dkp.json", "q-0")
+
+
+# --------------------------------------------------------------------------------------
+# Malformed folders: one-line error, exit status 2
+# --------------------------------------------------------------------------------------
+def test_malformed_folders(cert_dir, tmp_path, capsys):
+    assert main(["verify", str(tmp_path / "nowhere")]) == 2
+    d = _copy(cert_dir, tmp_path)
+    (d / "index.json").write_text("{not json")
+    assert main(["verify", str(d)]) == 2
+    index = _load(cert_dir, "index.json")
+    _save(d, "index.json", dict(index, version=2))
+    assert main(["verify", str(d)]) == 2
+    _save(d, "index.json", dict(index, files=index["files"] + ["missing.json"]))
+    assert main(["verify", str(d)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 4 and all(ln.startswith("intervalkin: error: ") for ln in err)
+    with pytest.raises(checker.CertificateFormatError):
+        checker.verify_directory(d)
+
+
+def test_bad_sample_size_refused(tmp_path, paper_geometry):
+    from intervalkin.errors import InputError
+
+    with pytest.raises(InputError, match="box_sample"):
+        write_certificates(tmp_path, paper_geometry, box_sample=-1)
+
+
+# --------------------------------------------------------------------------------------
+# Independence: the checker runs without the code it checks
+# --------------------------------------------------------------------------------------
+def test_checker_imports_none_of_the_checked_modules(cert_dir):
+    code = (
+        "import sys, intervalkin.checker as c\n"
+        f"r = c.verify_directory({str(cert_dir)!r})\n"
+        "assert r and all(x.verified for x in r), [x.line() for x in r if not x.verified]\n"
+        "mods = ['paving', 'predicates', 'regions', 'joint', 'dkp', 'analysis', 'kinematics', 'certificates']\n"
+        "print([m for m in mods if 'intervalkin.' + m in sys.modules])\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]", out.stdout + out.stderr
