@@ -318,7 +318,8 @@ def write_chain(a: Analysis, out: Path, figures: bool = True, stages: Stages | N
     write_vtu_paving(out / "pavings" / "workspace.vtu", p,
                      {k: cols[k] for k in ("in_workspace", "det_sign", "aspect", "basic_region", "uniqueness_domain",
                                            "depth")},
-                     mask=p.labels["W"] != Label.OUTSIDE)
+                     # a viewable file: the basic regions and the singular layer (the npz holds every box)
+                     mask=(ra.region >= 0) | ((p.labels["W"] == Label.INSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)))
     jc = a.joint.columns()
     atomic_write_bytes(out / "pavings" / "joint.npz", _npz_bytes(jc))
     st.done()

@@ -39,7 +39,6 @@ import numpy as np
 
 from .errors import InputError
 from .geometry import Geometry
-from .kinematics import rho_interval
 
 __all__ = [
     "JointCell",
@@ -225,7 +224,9 @@ def _range_sum(prefix: np.ndarray, ilo: np.ndarray, ihi: np.ndarray) -> np.ndarr
 
 def singular_image(geometry: Geometry, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Interval images g(b) of workspace boxes (m, 3, 2): (lo, hi) each (m, 3) in rho. Certified."""
-    r = rho_interval(geometry, boxes)
+    from .predicates import rho_sq_tight
+
+    r = [v.sqrt() for v in rho_sq_tight(geometry, np.asarray(boxes, dtype=np.float64))]
     lo = np.stack([np.asarray(ri.lo) for ri in r], axis=1)
     hi = np.stack([np.asarray(ri.hi) for ri in r], axis=1)
     return lo, hi

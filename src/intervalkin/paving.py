@@ -474,8 +474,9 @@ def shares_face(level: np.ndarray, ijk: np.ndarray, depth: int, periodic=(False,
     p = np.sort(p, axis=0)
     if p.size == 0:
         return np.zeros((2, 0), dtype=np.int64)
-    p = np.unique(p, axis=1)
-    return p
+    keys = np.sort(p[0] * np.int64(n) + p[1])  # 1-D keys: far faster than unique(axis=1)
+    keys = keys[np.concatenate(([True], keys[1:] != keys[:-1]))]
+    return np.stack([keys // n, keys % n])
 
 
 def shares_face_bruteforce(level, ijk, depth: int, periodic=(False, False, True)) -> np.ndarray:

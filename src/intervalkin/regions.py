@@ -310,12 +310,14 @@ def _solve_located(geometry, q, sign, locator):
     return [(locator.piece_of(np.asarray(s.box)), np.asarray(s.box)) for s in res.solutions if s.det_sign == sign]
 
 
-def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tries: int = 12, seed: int = 0):
+def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tries: int = 12, seed: int = 0,
+                   max_pieces: int = 40):
     """Sheet of each piece (-1 undecided) by certified elimination, and the witnesses used.
 
     Above a cell C with k = n_a(C) solutions of aspect a there are exactly k sheets.
     k = 1: every piece is in the one sheet.  Otherwise a reference joint vector q0
-    in C whose k solutions lie in k pieces names the sheets; a piece R is then put
+    in C whose k solutions lie in k pieces names the sheets (the ``max_pieces``
+    largest pieces of each cell and aspect are tried); a piece R is then put
     in sheet s when some q in C has one solution in R and its other k - 1
     solutions in pieces of k - 1 known sheets other than s (the solutions of q lie
     in k different sheets, by Theorem 1).
@@ -364,7 +366,7 @@ def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tri
         # eliminate, largest pieces first; a few passes as new sheets become known
         for _ in range(3):
             progress = False
-            for p in sorted(pids, key=lambda t: -piece_vol[t]):
+            for p in sorted(pids, key=lambda t: -piece_vol[t])[:max_pieces]:
                 if sheet[p] >= 0:
                     continue
                 boxes = np.flatnonzero(piece == p)
@@ -399,6 +401,7 @@ def _approx_g(geometry, pose):
 def _grow_into_layer(n: int, edges: np.ndarray, seeds: np.ndarray, layer: np.ndarray, max_steps: int = 10_000) -> np.ndarray:
     """Multi-source growth of ids into the layer boxes (nearest seed in the box graph)."""
     lab = seeds.copy()
+    edges = edges[:, layer[edges[0]] | layer[edges[1]]]  # edges inside the regions never change a label
     u, v = edges
     for _ in range(max_steps):
         a = (lab[u] >= 0) & (lab[v] < 0) & layer[v]
@@ -426,8 +429,9 @@ def region_adjacency(paving: Paving, edges: np.ndarray, region: np.ndarray) -> s
     for name in ASPECTS:
         in_aspect = paving.labels[name] == Label.INSIDE
         seeds = np.where(in_aspect & (region >= 0), region, -1).astype(np.int64)
-        lab = _grow_into_layer(n, edges, seeds, in_aspect & (region < 0))
-        u, v = edges
+        inner = edges[:, in_aspect[edges[0]] & in_aspect[edges[1]]]
+        lab = _grow_into_layer(n, inner, seeds, in_aspect & (region < 0))
+        u, v = inner
         m = (lab[u] >= 0) & (lab[v] >= 0) & (lab[u] != lab[v]) & in_aspect[u] & in_aspect[v]
         for a, b in set(zip(lab[u[m]].tolist(), lab[v[m]].tolist())):
             adj.add((min(a, b), max(a, b)))
