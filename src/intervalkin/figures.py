@@ -189,6 +189,8 @@ def _palette(k: int) -> list[str]:
     colours = []
     for cm in cmaps:
         colours.extend(cm(i) for i in range(20))
+    # greys read as "undecided": leave them out
+    colours = [c for c in colours if max(c[:3]) - min(c[:3]) > 0.08]
     return [colours[i % len(colours)] for i in range(max(k, 1))]
 
 
@@ -258,6 +260,7 @@ def render_ids_3d(paving: Paving, ids: np.ndarray, path, title: str, names=None,
                   seed: int = 0) -> Path:
     """3-D scatter of box centres coloured by an integer id per box (-1 not drawn)."""
     k = int(ids.max()) + 1 if ids.size and ids.max() >= 0 else 0
+    k = max(k, len(names) if names else 0)
     pal = _palette(k)
     layers = [(ids == i, pal[i], names[i] if names else f"{i}") for i in range(k)]
     return render_3d(paving, layers, path, title, max_points=max_points, seed=seed)
@@ -266,6 +269,7 @@ def render_ids_3d(paving: Paving, ids: np.ndarray, path, title: str, names=None,
 def render_ids_slices(paving: Paving, ids: np.ndarray, path, title: str, names=None, extra=None) -> Path:
     """phi-slices coloured by an integer id per box; ``extra`` = (mask, colour, name) drawn underneath."""
     k = int(ids.max()) + 1 if ids.size and ids.max() >= 0 else 0
+    k = max(k, len(names) if names else 0)
     pal = list(_palette(k))
     nm = list(names) if names else [f"{i}" for i in range(k)]
     codes = ids.astype(np.int16).copy()
