@@ -156,6 +156,26 @@ def test_checker_root_count_agrees_with_float_solver(paper_geometry, rng):
         done += 1
 
 
+def test_checker_det_formula_is_the_jacobian_determinant(paper_geometry, rng):
+    """The checker's short det A formula against the determinant of its own Jacobian rows, at points."""
+    from flint import arb, arb_mat
+
+    with ctx.workprec(128):
+        model = checker._Model(paper_geometry)
+        for _ in range(50):
+            x, y, phi = (arb(float(v)) for v in rng.uniform([-30, -30, -math.pi], [30, 30, math.pi]))
+            assert model.det(x, y, phi).overlaps(arb_mat(model.jacobian(x, y, phi)).det())
+
+
+def test_disjointness_reads_phi_modulo_two_pi():
+    a = ((0.0, 1.0), (0.0, 1.0), (3.1, 3.14))
+    b = ((0.5, 1.5), (0.5, 1.5), (-3.18, -3.15))  # 3.1 .. 3.14 and 3.103 .. 3.133 overlap mod 2 pi
+    c = ((0.5, 1.5), (0.5, 1.5), (-3.0, -2.9))
+    assert not checker._disjoint_mod_2pi(a, b)
+    assert checker._disjoint_mod_2pi(a, c)
+    assert checker._disjoint_mod_2pi(a, ((1.5, 2.0), (0.0, 1.0), (3.1, 3.14)))
+
+
 def test_box_label_refused_when_false(paper_geometry, cert_dir):
     """A box straddling det A = 0 cannot be re-proved with either sign."""
     doc = _load(cert_dir, "region_distinct.json")

@@ -440,10 +440,11 @@ def _disjoint_mod_2pi(b1, b2) -> bool:
     h = (arb(b1[2][1]) - arb(b1[2][0]) + arb(b2[2][1]) - arb(b2[2][0])) / 2
     if not h < arb.pi():
         return False
-    diff = c1 - c2
+    diff = c1 - c2  # the phi differences of the two boxes fill [diff - h, diff + h]
     k = round(float(diff.mid()) / (2 * math.pi))
-    # |diff - 2 k pi| > h, and every other multiple of 2 pi is farther than pi > h away
-    return bool(abs(diff - 2 * k * arb.pi()) > h)
+    # no multiple of 2 pi in that interval: the three nearest are checked, the others are
+    # at least 3 pi away from diff (k is within 1/2 + rounding of diff / 2 pi) and h < pi
+    return all(bool(abs(diff - 2 * j * arb.pi()) > h) for j in (k - 1, k, k + 1))
 
 
 def _reduced_sextic(model: _Model, rho_sq, phi0: float) -> list:
