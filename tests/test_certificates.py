@@ -111,6 +111,44 @@ def test_table1_alone(tmp_path, paper_geometry, table1):
     assert max(b[1] - b[0] for s in claim["solutions"] for b in s["box"]) < 1e-9
 
 
+_CONCURRENT = """
+name = "legs concurrent at the origin"
+[base]
+a1 = [12, 16]
+a2 = [24, 10]
+a3 = [16, -12]
+[platform]
+b1 = [0, 0]
+b2 = [9, 1]
+b3 = [5, -10]
+[limits]
+rho_min = 5
+rho_max = 40
+"""
+
+
+def test_incomplete_solve_claims_only_its_unique_boxes(tmp_path, capsys):
+    """q = (15, 13, 10) lies on g(S) (a double root): the claim says "not complete" and verifies as such;
+    declaring it complete is refused, since the checker cannot isolate the double root."""
+    import decimal
+    import tomllib
+
+    from intervalkin.geometry import parse_geometry
+
+    g = parse_geometry(tomllib.loads(_CONCURRENT, parse_float=decimal.Decimal), source="inline")
+    res = solve(g, [Fraction(15), Fraction(13), Fraction(10)])
+    assert not res.complete
+    write_certificates(tmp_path, g, dkp_results=[res])
+    (r,) = checker.verify_directory(tmp_path)
+    assert r.verified and "completeness not claimed" in r.message
+    doc = _load(tmp_path, "dkp.json")
+    assert doc["claims"][0]["complete"] is False and "b3 = [5, -10]" in doc["geometry_toml"]
+    doc["claims"][0].update(complete=True, phi0=0.0)
+    _save(tmp_path, "dkp.json", doc)
+    line = _refused(tmp_path, capsys, "dkp.json", "q-0")
+    assert "isolated" in line or "real roots" in line or "leading coefficient" in line
+
+
 def test_files_written_atomically_and_index_last(cert_dir):
     index = _load(cert_dir, "index.json")
     assert index["format"] == "intervalkin-certificate" and index["version"] == 1

@@ -685,6 +685,8 @@ def _check_box_labels(model: _Model, claim: dict, prec: int) -> tuple[str, dict]
     if not isinstance(boxes, list):
         raise _Refused("boxes: expected a list")
     size = _int(_get(claim, "sample_size"), "sample_size", 0)
+    if min(size, population) != len(boxes):
+        raise _Refused(f"{len(boxes)} boxes listed for a sample of {min(size, population)}")
     expect = sample_indices(seed, population, size)
     got = [b.get("index") if isinstance(b, dict) else None for b in boxes]
     if got != expect:
@@ -730,7 +732,7 @@ def check_claim(geometry: Geometry, kind: str, claim: dict, precision: int = 128
             msg, _ = _CHECKERS[kind](_Model(geometry), claim, prec)
     except _Refused as exc:
         return False, str(exc)
-    except (TypeError, KeyError, AttributeError, ValueError) as exc:
+    except (TypeError, KeyError, AttributeError, ValueError, OverflowError, ZeroDivisionError) as exc:
         return False, f"malformed claim ({type(exc).__name__}: {exc})"
     return True, msg
 
@@ -896,7 +898,7 @@ def verify_directory(path: str | Path) -> list[CheckResult]:
             except _Refused as exc:
                 results.append(CheckResult(name, cid, kind, False, str(exc)))
                 continue
-            except (TypeError, KeyError, AttributeError, ValueError) as exc:
+            except (TypeError, KeyError, AttributeError, ValueError, OverflowError, ZeroDivisionError) as exc:
                 results.append(CheckResult(name, cid, kind, False, f"malformed claim ({type(exc).__name__}: {exc})"))
                 continue
             verified[f"{name}#{cid}"] = facts
