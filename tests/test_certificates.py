@@ -107,7 +107,7 @@ def test_table1_alone(tmp_path, paper_geometry, table1):
     (r,) = checker.verify_directory(tmp_path)
     assert r.verified and "exactly 6 solutions (3 with det A > 0, 3 with det A < 0)" in r.message
     claim = _load(tmp_path, "dkp.json")["claims"][0]
-    assert claim["rho"] == ["749/50", "769/50", "12/1"] and claim["complete"] is True
+    assert claim["rho"] == ["14.98", "15.38", "12"] and claim["complete"] is True
     assert max(b[1] - b[0] for s in claim["solutions"] for b in s["box"]) < 1e-9
 
 
@@ -230,10 +230,10 @@ def test_box_label_refused_when_false(paper_geometry, cert_dir):
 # Tampering: each change must be refused (FAILED, exit status 1)
 # --------------------------------------------------------------------------------------
 def _bump_digit(text: str) -> str:
-    """Change the last digit of the numerator of "p/q" (by +1, 9 -> 8)."""
-    num, den = text.split("/")
-    d = int(num[-1])
-    return num[:-1] + str(d + 1 if d < 9 else d - 1) + "/" + den
+    """Change the last digit of an exact decimal (or of the numerator of "p/q") by +1 (9 -> 8)."""
+    head, sep, den = text.partition("/")
+    d = int(head[-1])
+    return head[:-1] + str(d + 1 if d < 9 else d - 1) + sep + den
 
 
 def test_tamper_witness_digit_of_joint_cell(cert_dir, tmp_path, capsys):
@@ -257,7 +257,7 @@ def test_tamper_witness_digit_of_region_claim(cert_dir, tmp_path, capsys):
 def test_tamper_dkp_joint_vector_digit(cert_dir, tmp_path, capsys):
     d = _copy(cert_dir, tmp_path)
     doc = _load(d, "dkp.json")
-    doc["claims"][0]["rho"][1] = "770/50"
+    doc["claims"][0]["rho"][1] = "15.39"
     _save(d, "dkp.json", doc)
     _refused(d, capsys, "dkp.json", "q-0")
 

@@ -22,8 +22,8 @@ Conventions for every file:
   (:meth:`~intervalkin.geometry.Geometry.to_toml`); the checker re-reads it with
   :func:`~intervalkin.geometry.parse_geometry` and requires every file to carry
   the index's text.
-* Joint vectors are exact: strings ``"p/q"`` or decimals ``"14.98"`` (never JSON
-  numbers).
+* Joint vectors are exact: decimal strings ``"14.98"`` when the value is a finite
+  decimal, else ``"p/q"`` (never JSON numbers).
 * A box is ``[[xlo, xhi], [ylo, yhi], [philo, phihi]]`` of binary64 numbers written
   in shortest round-trip form (Python ``repr``), phi in radians; the box is the
   set of reals between those binary64 values.
@@ -107,8 +107,21 @@ _PADS = (0.0, 1e-13, 1e-11)
 
 
 def _exact(q: Fraction) -> str:
+    """The exact decimal "14.98" when the denominator divides a power of ten, else "p/q"."""
     q = Fraction(q)
-    return f"{q.numerator}/{q.denominator}"
+    d, twos, fives = q.denominator, 0, 0
+    while d % 2 == 0:
+        d, twos = d // 2, twos + 1
+    while d % 5 == 0:
+        d, fives = d // 5, fives + 1
+    if d != 1:
+        return f"{q.numerator}/{q.denominator}"
+    digits = max(twos, fives)
+    if digits == 0:
+        return str(q.numerator)
+    scaled = abs(q.numerator) * 10**digits // q.denominator
+    sign = "-" if q < 0 else ""
+    return f"{sign}{scaled // 10**digits}.{scaled % 10**digits:0{digits}d}"
 
 
 def _box_json(box) -> list[list[float]]:
