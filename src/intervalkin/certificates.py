@@ -140,7 +140,7 @@ def _pad(box: list[list[float]], rel: float) -> list[list[float]]:
 
 
 def _rho_text(rho: Sequence[Fraction]) -> str:
-    return ", ".join(str(Fraction(r)) for r in rho)
+    return ", ".join(_exact(r) for r in rho)
 
 
 def _certified(geometry: Geometry, kind: str, claim: dict, precision: int, pads=_PADS,
