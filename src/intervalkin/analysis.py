@@ -394,6 +394,9 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
         st.done()
         summary["files"] += cert_files
     if paper:
+        st.start("certified trajectories between Table 1's solutions 2, 3, 6")
+        summary["trajectories"] = _paper_trajectories(a, out, summary["files"])
+        st.done()
         st.start("paper report")
         from .paper import write_report
 
@@ -535,3 +538,26 @@ def _label_from_npz(folder: Path, exact) -> dict:
     if res["in_workspace"] == "no":
         res["aspect"] = res["basic_region"] = res["uniqueness_domain"] = "none (outside W)"
     return res
+
+
+def _paper_trajectories(a: Analysis, out: Path, files: list[str]) -> list[dict]:
+    """Certified non-singular paths between Table 1's solutions 2, 3 and 6 (paper section 3.2, Fig. 13)."""
+    from .errors import IntervalkinError
+    from .paper import TABLE1_RHO
+    from .trajectory import trajectory, write_trajectory
+
+    done = []
+    for i, j in ((2, 3), (2, 6), (3, 6)):
+        try:
+            tr = trajectory(a.geometry, TABLE1_RHO, i, j, analysis=a.regions, joint=a.joint)
+        except IntervalkinError as exc:
+            done.append({"from": i, "to": j, "certified": False, "reason": str(exc)})
+            continue
+        folder = out / "trajectories" / f"{i}-{j}"
+        for path in write_trajectory(tr, a.geometry, folder, paving=a.regions.paving, joint=a.joint):
+            files.append(str(Path(path).relative_to(out)))
+        doc = tr.to_json()
+        doc["summary"] = tr.summary()
+        doc["folder"] = f"trajectories/{i}-{j}"
+        done.append(doc)
+    return done

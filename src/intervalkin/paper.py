@@ -336,6 +336,33 @@ def write_report(analysis, summary: dict, out, timings: dict) -> str:
     a(_fig("uniqueness_domains_slices.png", "Uniqueness domains (cf. Fig. 12)", files))
     a(_fig("top_cell_regions_3d.png", "The basic regions above the 6-solution cell (cf. Fig. 13)", files))
 
+    trs = summary.get("trajectories") or []
+    if trs:
+        a("## Non-singular assembly-mode changing trajectories (section 3.2, Figure 13)\n")
+        a("The paper shows that solutions 2, 3 and 6 of Table 1 can be joined without meeting a singularity, "
+          "and remarks that such a motion must pass through a joint-space domain with only two solutions. For "
+          "each pair, a path through boxes certified inside WA1 was found and every straight segment of it was "
+          "proved (interval evaluation of det A and of the leg lengths over enclosures of the segment's pieces) "
+          "to keep det A > 0 and 10 <= rho_i <= 32. The basic regions crossed are read at sampled points; the "
+          "joint cells crossed are certified.\n")
+        a("| path | certified | waypoints | basic regions crossed | joint cells crossed (count) | through a 2-solution cell |")
+        a("|---|---|---|---|---|---|")
+        for t in trs:
+            if "waypoints" not in t:
+                a(f"| {t['from']} -> {t['to']} | no | - | - | - | {t.get('reason', '')} |")
+                continue
+            regs = " -> ".join(str(r) for r in (t.get("basic_regions") or []))
+            cells = " -> ".join("layer" if c["cell"] == "layer" else f"{c['cell']} ({c['count']})"
+                                for c in (t.get("joint_cells") or []))
+            a(f"| {t['from']} -> {t['to']} | {'yes' if t['certified'] else 'NO'} | {len(t['waypoints'])} | {regs} | "
+              f"{cells} | {'yes' if t.get('through_two_solution_cell') else 'not seen at this depth'} |")
+        a("")
+        for t in trs:
+            if "folder" in t:
+                a(f"![Path {t['from']} -> {t['to']} in the workspace]({t['folder']}/trajectory_workspace_xy.png)\n")
+                a(f"![Path {t['from']} -> {t['to']} in joint space]({t['folder']}/trajectory_joint.png)\n")
+        a("The animations are in `trajectories/*/trajectory_animation.gif`.\n")
+
     a("## Depth, time, undecided volumes\n")
     for k, v in summary["timings_seconds"].items():
         a(f"- {k}: {v:.1f} s")
