@@ -155,8 +155,7 @@ def run_pave(geometry_path, depth, out, figures: bool = True, progress: bool = T
 # The whole chain: workspace, singular surface, joint cells, regions, domains
 # ======================================================================================
 MARKER = ".intervalkin-output"
-#: Default octree depth of ``analyze`` / ``paper`` (about a minute on two cores).
-DEFAULT_DEPTH = 8
+from . import DEFAULT_DEPTH  # noqa: E402  (about a minute on two cores)
 MAX_CHAIN_DEPTH = 9
 
 
@@ -399,6 +398,9 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
         st.done()
         st.start("paper report")
         from .paper import write_report
+
+        summary["timings_seconds"] = {**summary["timings_seconds"], **st.timings,
+                                      "total": time.perf_counter() - st.t0}
 
         summary["files"].append(write_report(a, summary, out, st.timings))
         st.done()

@@ -146,7 +146,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--geometry", metavar="FILE")
     p.add_argument("--depth", type=int, default=6, metavar="N", help="octree depth (default 6)")
     p.add_argument("--out", default="intervalkin-pave", metavar="DIR", help="output folder")
-    from .analysis import DEFAULT_DEPTH
+    from . import DEFAULT_DEPTH
 
     p = sub.add_parser("joint", help="joint space: enclosure of g(S) and cells of certified solution count")
     p.add_argument("--geometry", metavar="FILE")
