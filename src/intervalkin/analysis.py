@@ -140,7 +140,7 @@ def run_pave(geometry_path, depth, out, figures: bool = True, progress: bool = T
     if figures:
         from .figures import render_all
 
-        fig_files = render_all(paving, out / "figures")
+        fig_files = render_all(paving, out / "figures", base=geometry.base)
     t4 = time.perf_counter()
     timings = {"paving": t1 - t0, "components": t2 - t1, "export": t3 - t2, "figures": t4 - t3, "total": t4 - t0}
     summary = pave_summary(paving, info, timings)
@@ -327,7 +327,9 @@ def write_chain(a: Analysis, out: Path, figures: bool = True, stages: Stages | N
         st.start("figures")
         from .figures import render_all, render_joint, render_regions
 
-        figs = render_all(p, out / "figures") + render_joint(a.joint, out / "figures") + render_regions(ra, out / "figures")
+        base = a.geometry.base
+        figs = (render_all(p, out / "figures", base=base) + render_joint(a.joint, out / "figures")
+                + render_regions(ra, out / "figures", base=base))
         files += [f"figures/{f.name}" for f in figs]
         st.done()
     summary = chain_summary(a)

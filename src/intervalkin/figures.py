@@ -106,7 +106,7 @@ def slice_image(paving: Paving, phi: float, codes: np.ndarray, resolution: int =
 
 
 def render_slices(paving: Paving, codes: np.ndarray, palette, names, path, title: str,
-                  phis=None, resolution: int = 256):
+                  phis=None, resolution: int = 256, base=None):
     """A grid of x-y slices at several phi values; ``codes`` index ``palette`` (0..k-1)."""
     plt = _plt()
     from matplotlib.colors import ListedColormap
@@ -127,7 +127,8 @@ def render_slices(paving: Paving, codes: np.ndarray, palette, names, path, title
         ax.set_xticks([-30, 0, 30])
         ax.set_yticks([-30, 0, 30])
         ax.tick_params(labelsize=7)
-        ax.plot([0, 15.91, 0], [0, 0, 10], "k^", ms=4)
+        if base is not None:  # the base points A1, A2, A3
+            ax.plot([float(a[0]) for a in base], [float(a[1]) for a in base], "k^", ms=4)
     for ax in axes.ravel()[len(phis):]:
         ax.axis("off")
     handles = [Patch(color=c, label=n) for c, n in zip(palette, names)]
@@ -141,7 +142,7 @@ def render_slices(paving: Paving, codes: np.ndarray, palette, names, path, title
     return Path(path)
 
 
-def render_all(paving: Paving, out_dir, max_points: int = 40000) -> list[Path]:
+def render_all(paving: Paving, out_dir, max_points: int = 40000, base=None) -> list[Path]:
     """Write W, singular layer and aspects as 3-D views and phi-slices into ``out_dir``."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -165,7 +166,7 @@ def render_all(paving: Paving, out_dir, max_points: int = 40000) -> list[Path]:
     # slices: W / undecided; aspects / singular / undecided
     codes_w = np.where(w_in, 0, np.where(w_bd, 1, -1)).astype(np.int16)
     files.append(render_slices(paving, codes_w, [_W, _UND], ["W certified", "undecided"],
-                               out / "workspace_slices.png", f"Workspace W, phi-slices (depth {paving.depth})"))
+                               out / "workspace_slices.png", f"Workspace W, phi-slices (depth {paving.depth})", base=base))
     codes_a = np.full(len(paving), -1, np.int16)
     codes_a[w_bd] = 3
     codes_a[sing & w_in] = 2
@@ -173,7 +174,8 @@ def render_all(paving: Paving, out_dir, max_points: int = 40000) -> list[Path]:
     codes_a[wa2] = 1
     files.append(render_slices(paving, codes_a, [_WA1, _WA2, "#222222", "#bbbbbb"],
                                ["WA1 (det A > 0)", "WA2 (det A < 0)", "singular layer", "W undecided"],
-                               out / "aspects_slices.png", f"Aspects and singular layer, phi-slices (depth {paving.depth})"))
+                               out / "aspects_slices.png", f"Aspects and singular layer, phi-slices (depth {paving.depth})",
+                               base=base))
     return files
 
 
@@ -266,7 +268,7 @@ def render_ids_3d(paving: Paving, ids: np.ndarray, path, title: str, names=None,
     return render_3d(paving, layers, path, title, max_points=max_points, seed=seed)
 
 
-def render_ids_slices(paving: Paving, ids: np.ndarray, path, title: str, names=None, extra=None) -> Path:
+def render_ids_slices(paving: Paving, ids: np.ndarray, path, title: str, names=None, extra=None, base=None) -> Path:
     """phi-slices coloured by an integer id per box; ``extra`` = (mask, colour, name) drawn underneath."""
     k = int(ids.max()) + 1 if ids.size and ids.max() >= 0 else 0
     k = max(k, len(names) if names else 0)
@@ -279,10 +281,10 @@ def render_ids_slices(paving: Paving, ids: np.ndarray, path, title: str, names=N
         pal.append(colour)
         nm.append(name)
     short = [n.split(":")[0] for n in nm] if len(nm) > 10 else nm
-    return render_slices(paving, codes, pal, short, path, title)
+    return render_slices(paving, codes, pal, short, path, title, base=base)
 
 
-def render_regions(analysis, out_dir) -> list[Path]:
+def render_regions(analysis, out_dir, base=None) -> list[Path]:
     """The paper's Figures 9, 10, 12 and 13 from a :class:`regions.RegionAnalysis`."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -299,20 +301,21 @@ def render_regions(analysis, out_dir) -> list[Path]:
     files.append(render_slices(p, codes, [_WA1, _WA2, "#ffb703", "#222222"],
                                ["WA1 off S_c", "WA2 off S_c", "may meet S_c (characteristic)", "singular layer"],
                                out / "characteristic_slices.png",
-                               f"Characteristic surfaces S_c1, S_c2 (outer enclosure; cf. paper Fig. 9), depth {p.depth}"))
+                               f"Characteristic surfaces S_c1, S_c2 (outer enclosure; cf. paper Fig. 9), depth {p.depth}",
+                               base=base))
     files.append(render_3d(p, [(sc & (p.labels["WA1"] == Label.INSIDE), "#ffb703", "S_c1 enclosure"),
                                (sing & (p.labels["W"] == Label.INSIDE), "#222222", "singular layer")],
                            out / "characteristic_3d.png", "Characteristic surface of WA1 and singular layer (Fig. 9)"))
     names = [f"{r.id}: {r.aspect} cell {r.cell} ({r.cell_count} sol.)" for r in analysis.regions]
     files.append(render_ids_slices(p, analysis.region, out / "basic_regions_slices.png",
                                    f"{len(analysis.regions)} basic regions (cf. paper Fig. 10)", names,
-                                   extra=(sc, "#eeeeee", "undecided")))
+                                   extra=(sc, "#eeeeee", "undecided"), base=base))
     files.append(render_ids_3d(p, analysis.region, out / "basic_regions_3d.png",
                                f"Basic regions (cf. paper Fig. 10)", names))
     dnames = [f"domain {i}" for i in range(len(analysis.domains))]
     files.append(render_ids_slices(p, analysis.domain, out / "uniqueness_domains_slices.png",
                                    f"{len(analysis.domains)} uniqueness domains (cf. paper Fig. 12)", dnames,
-                                   extra=(in_aspect, "#eeeeee", "undecided")))
+                                   extra=(in_aspect, "#eeeeee", "undecided"), base=base))
     files.append(render_ids_3d(p, analysis.domain, out / "uniqueness_domains_3d.png",
                                "Uniqueness domains (cf. paper Fig. 12)", dnames))
     if analysis.regions:
