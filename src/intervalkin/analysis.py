@@ -565,3 +565,36 @@ def _paper_trajectories(a: Analysis, out: Path, files: list[str]) -> list[dict]:
         doc["folder"] = f"trajectories/{i}-{j}"
         done.append(doc)
     return done
+
+
+def run_trajectory(geometry_path, rho, i_from: int, i_to: int, depth: int = 7, out=None,
+                   as_json: bool = False, quiet: bool = False) -> int:
+    """``intervalkin trajectory``: the chain at ``depth``, then a certified path between two solutions.
+
+    The request is checked first (solutions of different aspects are refused at
+    once, before any paving).
+    """
+    import json
+
+    from .geometry import geometry_from_option
+    from .trajectory import check_request, trajectory, write_trajectory
+
+    geometry = geometry_from_option(geometry_path)
+    check_request(geometry, rho, i_from, i_to)
+    if isinstance(depth, bool) or not isinstance(depth, int) or not 3 <= depth <= MAX_CHAIN_DEPTH:
+        raise InputError(f"--depth: expected an integer in 3..{MAX_CHAIN_DEPTH}, got {depth!r}")
+    if out is not None:
+        out = prepare_output_dir(out, force=True) if Path(out).is_dir() and (Path(out) / MARKER).exists() \
+            else prepare_output_dir(out, force=False)
+    st = Stages(quiet=quiet or as_json)
+    a = analyse(geometry, depth, st)
+    st.start("certified path")
+    traj = trajectory(geometry, rho, i_from, i_to, analysis=a.regions, joint=a.joint)
+    st.done()
+    if out is not None:
+        write_trajectory(traj, geometry, out, paving=a.regions.paving, joint=a.joint)
+    if as_json:
+        sys.stdout.write(json.dumps(traj.to_json()) + "\n")
+    else:
+        sys.stdout.write(traj.summary() + "\n")
+    return 0

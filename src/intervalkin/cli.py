@@ -89,18 +89,10 @@ def _cmd_label(args: argparse.Namespace) -> int:
 
 
 def _cmd_trajectory(args: argparse.Namespace) -> int:
-    from .geometry import geometry_from_option
-    from .trajectory import trajectory_with_regions, write_trajectory
+    from .analysis import run_trajectory
 
-    geometry = geometry_from_option(args.geometry)
-    traj, ra, jp = trajectory_with_regions(geometry, args.rho, args.i_from, args.i_to, depth=args.depth)
-    if args.out:
-        write_trajectory(traj, geometry, args.out, paving=ra.paving, joint=jp)
-    if args.json:
-        _print_json(traj.to_json())
-    else:
-        sys.stdout.write(traj.summary() + "\n")
-    return 0
+    return run_trajectory(args.geometry, args.rho, args.i_from, args.i_to, depth=args.depth, out=args.out,
+                          as_json=args.json)
 
 
 def _cmd_verify(args: argparse.Namespace) -> int:

@@ -96,11 +96,11 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "NoPathError",
+    "check_request",
     "SegmentCertificate",
     "Trajectory",
     "certify_segment",
     "trajectory",
-    "trajectory_with_regions",
     "render_trajectory",
     "write_trajectory",
     "MAX_BISECTIONS",
@@ -450,6 +450,11 @@ def _joint_vector(geometry: Geometry, rho) -> tuple[Fraction, Fraction, Fraction
                                  f"[{float(geometry.rho_min[i])}, {float(geometry.rho_max[i])}]")
         return out  # type: ignore[return-value]
     return parse_joint_vector(geometry, [str(v) for v in vals])
+
+
+def check_request(geometry: Geometry, rho, i_from: int, i_to: int) -> None:
+    """Raise (one-line :class:`IntervalkinError`) when no path can be asked for; cheap (one solve)."""
+    _endpoints(geometry, rho, i_from, i_to)
 
 
 def _endpoints(geometry: Geometry, rho, i_from: int, i_to: int):
@@ -908,37 +913,6 @@ def _cell_info(joint: "JointPaving", c: int) -> dict:
         return {"cell": -1, "count": -1, "n_wa1": -1, "n_wa2": -1}
     cell = joint.cells[c]
     return {"cell": int(c), "count": int(cell.count), "n_wa1": int(cell.n_wa1), "n_wa2": int(cell.n_wa2)}
-
-
-def trajectory_with_regions(
-    geometry: Geometry,
-    rho: Sequence,
-    i_from: int,
-    i_to: int,
-    depth: int = 7,
-    joint_depth: int | None = None,
-    progress=None,
-) -> tuple[Trajectory, "RegionAnalysis", "JointPaving"]:
-    """The whole chain for the command line: joint cells, basic regions, then the trajectory.
-
-    The request is checked first (different aspects fail at once, before any
-    paving).  ``joint_depth`` defaults to min(6, depth - 1).
-    """
-    from .joint import joint_paving
-    from .paving import check_depth
-    from .predicates import pave_workspace
-    from .regions import analyse_regions
-
-    depth = check_depth(depth)
-    _endpoints(geometry, rho, i_from, i_to)
-    jd = min(6, max(depth - 1, 1)) if joint_depth is None else joint_depth
-    p = pave_workspace(geometry, depth)
-    sel = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
-    jp = joint_paving(geometry, p.boxes[sel], jd)
-    del p
-    ra = analyse_regions(geometry, jp, depth, progress=progress)
-    tr = trajectory(geometry, rho, i_from, i_to, depth=depth, analysis=ra, joint=jp)
-    return tr, ra, jp
 
 
 # --------------------------------------------------------------------------------------
