@@ -63,9 +63,12 @@ def render_3d(paving: Paving, layers, path, title: str, max_points: int = 40000,
     ax.set_zlim(-np.pi, np.pi)
     ax.view_init(elev=22, azim=-60)
     ax.set_title(title, fontsize=11)
-    leg = ax.legend(loc="upper left", fontsize=8, markerscale=4)
-    for h in leg.legend_handles:
-        h.set_alpha(1)
+    if ax.get_legend_handles_labels()[0]:
+        leg = ax.legend(loc="upper left", fontsize=8, markerscale=4)
+        for h in leg.legend_handles:
+            h.set_alpha(1)
+    else:
+        ax.text2D(0.05, 0.95, "no certified box at this depth", transform=ax.transAxes, fontsize=9)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
