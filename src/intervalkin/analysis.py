@@ -183,6 +183,14 @@ class Stages:
         return None if self.quiet else ProgressBar(self.stream)
 
 
+def check_chain_depth(depth) -> int:
+    """A user depth for the chain: an integer in 3..MAX_CHAIN_DEPTH whose singular layer fits in memory."""
+    if isinstance(depth, bool) or not isinstance(depth, int) or not 3 <= depth <= MAX_CHAIN_DEPTH:
+        raise InputError(f"--depth: expected an integer in 3..{MAX_CHAIN_DEPTH}, got {depth!r}")
+    check_depth(depth + 1)
+    return depth
+
+
 def chain_depths(depth: int) -> tuple[int, int, int]:
     """(workspace depth, singular-layer depth, joint depth) for a user depth."""
     return depth, depth + 1, min(depth - 1, 7)
@@ -212,9 +220,7 @@ def analyse(geometry, depth: int = DEFAULT_DEPTH, stages: Stages | None = None) 
     from .joint import joint_paving, pave_singular_layer
     from .regions import analyse_regions
 
-    if isinstance(depth, bool) or not isinstance(depth, int) or not 3 <= depth <= MAX_CHAIN_DEPTH:
-        raise InputError(f"--depth: expected an integer in 3..{MAX_CHAIN_DEPTH}, got {depth!r}")
-    check_depth(depth + 1)
+    check_chain_depth(depth)
     st = stages or Stages(quiet=True)
     dw, ds, dj = chain_depths(depth)
     st.start(f"singular layer (depth {ds})")
@@ -382,9 +388,7 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
     from .geometry import default_geometry, geometry_from_option
 
     geometry = default_geometry() if paper else geometry_from_option(geometry_path)
-    if isinstance(depth, bool) or not isinstance(depth, int) or not 3 <= depth <= MAX_CHAIN_DEPTH:
-        raise InputError(f"--depth: expected an integer in 3..{MAX_CHAIN_DEPTH}, got {depth!r}")
-    check_depth(depth + 1)
+    check_chain_depth(depth)
     out = prepare_output_dir(out, force)
     st = Stages(quiet=quiet)
     a = analyse(geometry, depth, st)
@@ -581,8 +585,7 @@ def run_trajectory(geometry_path, rho, i_from: int, i_to: int, depth: int = 7, o
 
     geometry = geometry_from_option(geometry_path)
     check_request(geometry, rho, i_from, i_to)
-    if isinstance(depth, bool) or not isinstance(depth, int) or not 3 <= depth <= MAX_CHAIN_DEPTH:
-        raise InputError(f"--depth: expected an integer in 3..{MAX_CHAIN_DEPTH}, got {depth!r}")
+    check_chain_depth(depth)
     if out is not None:
         out = prepare_output_dir(out, force=True) if Path(out).is_dir() and (Path(out) / MARKER).exists() \
             else prepare_output_dir(out, force=False)

@@ -381,19 +381,12 @@ def pave_singular_layer(geometry: Geometry, depth: int, progress=None) -> np.nda
     so its size grows about 4x per level, not 8x.  Every other box is certified
     free of singular points of W.
     """
-    from .paving import Label, pave_multi, workspace_paving_domain
-    from .predicates import det_sign_predicate, workspace_predicate
+    from .paving import Label
+    from .predicates import pave_workspace
 
     def split(labels):
         return (labels["W"] != Label.OUTSIDE) & (labels["det_positive"] == Label.BOUNDARY)
 
-    p = pave_multi(
-        workspace_paving_domain(geometry),
-        [("W", workspace_predicate(geometry)), ("det_positive", det_sign_predicate(geometry))],
-        depth,
-        split=split,
-        relevant={"det_positive": lambda labels: labels["W"] != Label.OUTSIDE},
-        progress=progress,
-    )
+    p = pave_workspace(geometry, depth, progress=progress, split=split)
     sel = split(p.labels)
     return p.boxes[sel]

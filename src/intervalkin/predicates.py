@@ -345,17 +345,20 @@ def aspect_predicate(geometry: Geometry, sign: int):
     return and_predicates(workspace_predicate(geometry), d if sign > 0 else not_predicate(d))
 
 
-def pave_workspace(geometry: Geometry, depth: int, progress=None) -> Paving:
+def pave_workspace(geometry: Geometry, depth: int, progress=None, split=None) -> Paving:
     """Pave W, the sign of det A and the two aspects in one pass.
 
     Labels: ``W``, ``det_positive`` (INSIDE: det A > 0, OUTSIDE: det A < 0),
     ``WA1``, ``WA2``.  A box is split while W is undecided, or while W holds on it
     and the sign of det A is undecided (that is: while an aspect label is
-    undecided).  det A is not evaluated on boxes certified outside W.
+    undecided).  det A is not evaluated on boxes certified outside W.  ``split``
+    replaces that rule (labels -> bool mask of the boxes to subdivide).
     """
-    def split(labels):
+    def aspect_split(labels):
         w, d = labels["W"], labels["det_positive"]
         return (w == Label.BOUNDARY) | ((w == Label.INSIDE) & (d == Label.BOUNDARY))
+
+    split = aspect_split if split is None else split
 
     p = pave_multi(
         workspace_paving_domain(geometry),
