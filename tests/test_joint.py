@@ -149,3 +149,16 @@ def test_columns_have_the_documented_layout(joint):
     assert np.all(cols["lo"] < cols["hi"])
     und = cols["cell"] < 0
     assert np.all(cols["count"][und] == -1)
+
+
+def test_possibly_joined_cells_have_equal_counts_and_touch_the_layer(joint):
+    """Reported pairs: equal certified counts; two cells in one face-connected block would be one cell."""
+    assert joint.joinable
+    for a, b in joint.joinable:
+        assert a != b and joint.cells[a].count == joint.cells[b].count >= 0
+    # no two different cells are face-adjacent without marked voxels between them
+    c = joint.cell
+    for axis in range(3):
+        x = np.moveaxis(c, axis, 0)
+        touch = (x[:-1] >= 0) & (x[1:] >= 0)
+        assert np.all(x[:-1][touch] == x[1:][touch])

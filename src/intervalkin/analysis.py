@@ -244,11 +244,13 @@ def joint_summary(jp) -> dict:
         "volume_by_count": jp.volume_by_count(),
         "undecided_share": float(jp.marked.mean()),
         "singular_boxes": jp.n_singular_boxes,
+        "possibly_joined_cells": [list(p) for p in jp.joinable],
         "certified": {
             "counts": "each cell is a face-connected set of voxels certified off the outer enclosure of g(S); "
                       "its count and aspect split come from one certified solve and hold at every point of it",
             "distinct": "cells with different counts are different components of the joint box minus g(S); "
-                        "two cells with equal counts may be one true component joined through the undecided layer",
+                        "two cells with equal counts may be one true component joined through the undecided layer: "
+                        "possibly_joined_cells lists the pairs separated only by a stretch of that layer",
         },
     }
 

@@ -100,6 +100,8 @@ class JointPaving:
     cell : int32 (N, N, N), cell id, -1 on marked voxels.
     cells : the cells, by id.
     n_singular_boxes : number of workspace boxes whose images make the enclosure.
+    joinable : pairs of cells of equal count that the undecided layer may join
+        (their nearest-cell shares of the marked voxels touch): not certified different.
     """
 
     geometry: Geometry
@@ -112,6 +114,7 @@ class JointPaving:
     cells: tuple[JointCell, ...]
     n_singular_boxes: int
     seconds: float
+    joinable: tuple[tuple[int, int], ...] = ()
 
     @property
     def n(self) -> int:
@@ -255,20 +258,48 @@ def _summed_area(marked: np.ndarray) -> np.ndarray:
     return p
 
 
+def _grid_edges(shape) -> np.ndarray:
+    """Face-adjacent voxel pairs (2, m) of a 3-D grid (C-order indices), no wrap."""
+    idx = np.arange(int(np.prod(shape))).reshape(shape)
+    edges = []
+    for axis in range(3):
+        a = np.take(idx, range(shape[axis] - 1), axis=axis).ravel()
+        b = np.take(idx, range(1, shape[axis]), axis=axis).ravel()
+        edges.append(np.stack([a, b]))
+    return np.concatenate(edges, axis=1)
+
+
 def _grid_components(free: np.ndarray) -> np.ndarray:
     """Face-connected components of the True voxels of a 3-D grid; -1 elsewhere."""
     from .paving import component_labels
 
-    n = free.size
-    idx = np.arange(n).reshape(free.shape)
-    edges = []
-    for axis in range(3):
-        a = np.take(idx, range(free.shape[axis] - 1), axis=axis).ravel()
-        b = np.take(idx, range(1, free.shape[axis]), axis=axis).ravel()
-        keep = free.ravel()[a] & free.ravel()[b]
-        edges.append(np.stack([a[keep], b[keep]]))
-    e = np.concatenate(edges, axis=1) if edges else np.zeros((2, 0), dtype=np.int64)
-    return component_labels(n, e, free.ravel()).reshape(free.shape)
+    e = _grid_edges(free.shape)
+    flat = free.ravel()
+    e = e[:, flat[e[0]] & flat[e[1]]]
+    return component_labels(free.size, e, flat).reshape(free.shape)
+
+
+def _joinable_pairs(cell_grid: np.ndarray, marked: np.ndarray, counts: Sequence[int]) -> tuple[tuple[int, int], ...]:
+    """Cells of equal count that the undecided layer may join.
+
+    The marked voxels are shared out to the nearest cell (growth through face
+    adjacency); two cells whose shares touch are separated only by a stretch of
+    the layer, so they may be one true component of the joint box minus g(S).
+    Cells whose shares do not touch are still not PROVED different (the layer is
+    an outer enclosure); this is a report of where the doubt is, not a proof.
+    """
+    from .paving import grow_labels
+
+    e = _grid_edges(cell_grid.shape)
+    lab = grow_labels(cell_grid.size, e, cell_grid.ravel(), marked.ravel())
+    u, v = e
+    m = (lab[u] >= 0) & (lab[v] >= 0) & (lab[u] != lab[v])
+    pairs = set()
+    for a, b in set(zip(lab[u[m]].tolist(), lab[v[m]].tolist())):
+        a, b = min(a, b), max(a, b)
+        if counts[a] >= 0 and counts[a] == counts[b]:
+            pairs.add((a, b))
+    return tuple(sorted(pairs))
 
 
 def _representative_voxel(cell_grid: np.ndarray, cid: int, rng: np.random.Generator, k: int = 0) -> tuple[int, int, int]:
@@ -347,8 +378,9 @@ def joint_paving(
             JointCell(cid, int(sizes[cid]), sizes[cid] * voxel_volume, sizes[cid] * voxel_volume / total_volume,
                       count, n1, n2, witness, complete)
         )
+    joinable = _joinable_pairs(cell_grid, marked, [c.count for c in cells])
     return JointPaving(geometry, depth, rho_min, step, marked, prefix, cell_grid, tuple(cells),  # type: ignore[arg-type]
-                       int(len(singular_boxes)), time.perf_counter() - t0)
+                       int(len(singular_boxes)), time.perf_counter() - t0, joinable)
 
 
 def solution_count(geometry: Geometry, rho: Sequence, paving: JointPaving | None = None) -> tuple[int, int, int, str]:

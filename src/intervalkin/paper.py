@@ -305,6 +305,13 @@ def write_report(analysis, summary: dict, out, timings: dict) -> str:
     a(f"\nUndecided (may meet g(S)): {100 * float(jp.marked.mean()):.1f}% of the joint box. In every cell the "
       "solutions split equally between the two aspects. Cells of equal count may be one true domain joined "
       "through the undecided layer; single-voxel cells are almost certainly such pieces.\n")
+    big = {c.id for c in jp.cells if c.n_voxels > 1}
+    pairs = [p for p in jp.joinable if p[0] in big and p[1] in big]
+    if pairs:
+        a("Pairs of cells of equal count separated only by a stretch of the undecided layer (their nearest-cell "
+          "shares of the layer touch), hence possibly one domain of the paper: "
+          + ", ".join(f"{i}-{j}" for i, j in pairs) + ". If such cells were one domain, the basic regions above "
+          "them would coincide and the count of basic regions would drop; this is why 28 is not claimed exact.\n")
     a(_fig("joint_slices.png", "Joint space, rho3-slices by certified count (cf. Figs. 2, 11)", files))
     a(_fig("joint_3d.png", "Joint space cells (cf. Fig. 11)", files))
 

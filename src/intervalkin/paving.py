@@ -560,6 +560,32 @@ def component_labels(n: int, edges: np.ndarray, mask: np.ndarray) -> np.ndarray:
     return out
 
 
+def grow_labels(n: int, edges: np.ndarray, seeds: np.ndarray, layer: np.ndarray, max_steps: int = 100_000) -> np.ndarray:
+    """Multi-source growth of integer labels into the ``layer`` nodes (nearest seed by graph distance).
+
+    ``seeds`` (n,) holds a label >= 0 on seed nodes and -1 elsewhere; each step
+    gives every unlabelled layer node adjacent to a labelled node the smallest
+    neighbouring label.  Returns the grown labels (layer nodes out of reach
+    stay -1).  Cost: one pass over the edges that touch the layer per step.
+    """
+    lab = np.asarray(seeds, dtype=np.int64).copy()
+    layer = np.asarray(layer, dtype=bool)
+    edges = edges[:, layer[edges[0]] | layer[edges[1]]]  # edges between seeds never change a label
+    u, v = edges
+    big = np.iinfo(np.int64).max
+    for _ in range(max_steps):
+        a = (lab[u] >= 0) & (lab[v] < 0) & layer[v]
+        b = (lab[v] >= 0) & (lab[u] < 0) & layer[u]
+        if not (np.any(a) or np.any(b)):
+            break
+        new = np.full(n, big, dtype=np.int64)
+        np.minimum.at(new, v[a], lab[u[a]])
+        np.minimum.at(new, u[b], lab[v[b]])
+        upd = new != big
+        lab[upd] = new[upd]
+    return lab
+
+
 def connected_components(n: int, edges: np.ndarray, mask: np.ndarray) -> list[frozenset]:
     """Components (frozensets of box indices) of the selected boxes, via networkx."""
     import networkx as nx
