@@ -123,3 +123,17 @@ def test_joint_command(tmp_path, capsys):
     counts = {c["count"] for c in s["joint"]["cells"]}
     assert {2, 4} <= counts
     assert "count" in capsys.readouterr().out
+
+
+def test_refinement_deepens_until_consistent_or_limit(tmp_path):
+    from intervalkin.analysis import analyse
+    from intervalkin.geometry import default_geometry
+
+    a = analyse(default_geometry(), 5, refine_to=6)
+    h = list(a.refinement)
+    assert h[0]["depth"] == 5 and 1 <= len(h) <= 2
+    assert h[-1]["consistent"] or h[-1]["depth"] == 6
+    assert a.depth == h[-1]["depth"] == a.regions.paving.depth
+    assert "stopped" in h[-1]
+    with pytest.raises(Exception, match="--refine-to"):
+        analyse(default_geometry(), 5, refine_to=4)

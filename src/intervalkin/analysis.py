@@ -208,14 +208,22 @@ class Analysis:
     joint: object
     regions: object
     timings: dict
+    refinement: tuple = ()
 
 
-def analyse(geometry, depth: int = DEFAULT_DEPTH, stages: Stages | None = None) -> Analysis:
+def analyse(geometry, depth: int = DEFAULT_DEPTH, stages: Stages | None = None, refine_to: int | None = None) -> Analysis:
     """Run the chain geometry -> singular layer -> joint cells -> regions -> uniqueness domains.
 
     ``depth`` is the octree depth of the workspace paving; the singular layer
     is paved one level deeper and the joint grid has 2**min(depth - 1, 7) voxels
     per axis (see :func:`chain_depths`).
+
+    ``refine_to``: while Proposition 1 is not seen in full (a sheet above a
+    counted cell holds no certified box), pave the regions one level deeper, up
+    to this depth.  The paver only splits undecided boxes, so a deeper level
+    refines near the characteristic surfaces, the singular layer and the joint
+    limits, not the whole domain.  ``Analysis.refinement`` records each try and
+    why it stopped.
     """
     from .joint import joint_paving, pave_singular_layer
     from .regions import analyse_regions
@@ -232,7 +240,23 @@ def analyse(geometry, depth: int = DEFAULT_DEPTH, stages: Stages | None = None) 
     st.start(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})")
     ra = analyse_regions(geometry, jp, dw, progress=st.bar())
     st.done()
-    return Analysis(geometry, dw, ds, dj, len(sing), jp, ra, dict(st.timings))
+    history = [{"depth": dw, "consistent": ra.consistent, "basic_regions": len(ra.regions)}]
+    if refine_to is not None:
+        if isinstance(refine_to, bool) or not isinstance(refine_to, int) or not dw <= refine_to <= MAX_CHAIN_DEPTH:
+            raise InputError(f"--refine-to: expected an integer in {dw}..{MAX_CHAIN_DEPTH}, got {refine_to!r}")
+        while not ra.consistent and dw < refine_to:
+            dw += 1
+            st.start(f"refining where Proposition 1 is not yet seen in full: regions at depth {dw}")
+            ra = analyse_regions(geometry, jp, dw, progress=st.bar())
+            st.done()
+            history.append({"depth": dw, "consistent": ra.consistent, "basic_regions": len(ra.regions)})
+    if ra.consistent:
+        history[-1]["stopped"] = "consistent: every sheet above every counted cell holds certified boxes"
+    elif refine_to is None:
+        history[-1]["stopped"] = "not consistent at this depth; no refinement asked (--refine-to)"
+    else:
+        history[-1]["stopped"] = f"limit reached (depth {dw}) before consistency"
+    return Analysis(geometry, dw, ds, dj, len(sing), jp, ra, dict(st.timings), tuple(history))
 
 
 def joint_summary(jp) -> dict:
@@ -283,6 +307,7 @@ def chain_summary(a: Analysis) -> dict:
                            & (p.labels["off_Sc"] != Label.INSIDE)].sum()
             ),
             "timings_seconds": a.timings,
+            "refinement": list(a.refinement),
             "certified": CERTIFIED_NOTE,
         }
     )
@@ -383,7 +408,8 @@ def chain_table(summary: dict) -> str:
 
 
 def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool = False, as_json: bool = False,
-                figures: bool = True, certificates: bool = True, paper: bool = False) -> int:
+                figures: bool = True, certificates: bool = True, paper: bool = False,
+                refine_to: int | None = None) -> int:
     """``intervalkin analyze`` (and ``paper`` when paper=True): the whole chain into one folder."""
     import json
 
@@ -393,7 +419,7 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
     check_chain_depth(depth)
     out = prepare_output_dir(out, force)
     st = Stages(quiet=quiet)
-    a = analyse(geometry, depth, st)
+    a = analyse(geometry, depth, st, refine_to=refine_to)
     summary = write_chain(a, out, figures=figures, stages=st)
     if certificates:
         st.start("certificates")

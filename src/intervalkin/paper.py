@@ -386,6 +386,10 @@ def write_report(analysis, summary: dict, out, timings: dict) -> str:
     u = summary["undecided_volume"]
     a(f"- undecided volume: W {u['W']:.1f}, WA1 {u['WA1']:.1f}, WA2 {u['WA2']:.1f}; characteristic layer "
       f"{summary['characteristic_layer_volume']:.1f}")
-    a("\nA deeper run (`intervalkin paper --depth 9`) thins every undecided layer by about half.\n")
+    for h in getattr(analysis, "refinement", ()):
+        a(f"- regions at depth {h['depth']}: {h['basic_regions']} basic regions, Proposition 1 seen in full: "
+          f"{'yes' if h['consistent'] else 'no'}" + (f" ({h['stopped']})" if "stopped" in h else ""))
+    a("\nA deeper run (`intervalkin paper --depth 9`) thins every undecided layer by about half; "
+      "`--refine-to 9` deepens only the regions paving, and only while Proposition 1 is not seen in full.\n")
     atomic_write_bytes(Path(out) / "report.md", ("\n".join(L) + "\n").encode())
     return "report.md"
