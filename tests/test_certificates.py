@@ -21,6 +21,7 @@ from intervalkin.joint import joint_paving
 from intervalkin.paving import Label
 from intervalkin.predicates import pave_workspace
 from intervalkin.regions import analyse_regions
+from intervalkin.trajectory import trajectory
 
 TABLE1 = ["14.98", "15.38", "12.0"]
 
@@ -41,10 +42,17 @@ def chain(paper_geometry):
 
 
 @pytest.fixture(scope="module")
-def cert_dir(tmp_path_factory, paper_geometry, chain, table1):
+def paths(paper_geometry):
+    """Certified paths between Table 1's solutions 2 -> 3 (phi_turns 0) and 3 -> 6 (phi_turns -1), depth 6."""
+    return [trajectory(paper_geometry, TABLE1, i, j, depth=6) for i, j in ((2, 3), (3, 6))]
+
+
+@pytest.fixture(scope="module")
+def cert_dir(tmp_path_factory, paper_geometry, chain, table1, paths):
     jp, ra = chain
     out = tmp_path_factory.mktemp("certificates")
-    write_certificates(out, paper_geometry, dkp_results=[table1], joint=jp, regions=ra, box_sample=120, seed=7)
+    write_certificates(out, paper_geometry, dkp_results=[table1], joint=jp, regions=ra, box_sample=120, seed=7,
+                       trajectories=paths)
     return out
 
 
@@ -416,3 +424,101 @@ def test_checker_imports_none_of_the_checked_modules(cert_dir):
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]", out.stdout + out.stderr
+
+
+# --------------------------------------------------------------------------------------
+# Trajectories: the certified motion re-proved from the file
+# --------------------------------------------------------------------------------------
+def test_trajectory_claims_verify_and_copy_the_segment_certificate(cert_dir, paths):
+    claims = {c["id"]: c for c in _load(cert_dir, "trajectory.json")["claims"]}
+    assert sorted(claims) == ["2-3", "3-6"] and all(tr.certified for tr in paths)
+    for tr in paths:
+        c = claims[f"{tr.i_from}-{tr.i_to}"]
+        cert = tr.certificate()
+        assert [{k: s[k] for k in ("start", "end", "pieces")} for s in cert["segments"]] == c["segments"]
+        assert c["rho"] == ["14.98", "15.38", "12"] and c["aspect"] == "WA1" and c["phi_turns"] == tr.phi_turns
+    assert claims["3-6"]["phi_turns"] == -1  # the goal is reached across the seam
+    results = [r for r in checker.verify_directory(cert_dir) if r.kind == "trajectory"]
+    assert len(results) == 2 and all(r.verified for r in results), [r.line() for r in results]
+    assert all("keeps det A > 0 and 10 <= rho_1 <= 32" in r.message for r in results)
+
+
+def test_uncertified_trajectory_is_omitted(tmp_path, paper_geometry, paths):
+    import dataclasses
+
+    bad = dataclasses.replace(paths[0], certified=False, reason="test")
+    write_certificates(tmp_path, paper_geometry, trajectories=[bad, paths[1]])
+    assert [c["id"] for c in _load(tmp_path, "trajectory.json")["claims"]] == ["3-6"]
+    assert _load(tmp_path, "index.json")["omitted"][0]["what"] == "trajectory 2-3"
+
+
+def _set_end(claim: dict, k: int, coord: int, value: float) -> None:
+    """Move the end point shared by segments k and k + 1 (and its waypoint) consistently."""
+    h = value.hex()
+    claim["segments"][k]["end"][coord] = [h, h]
+    claim["segments"][k + 1]["start"][coord] = [h, h]
+    claim["waypoints"][k + 1][coord] = h
+
+
+def _tamper_waypoint_phi(c):  # turns the platform by 1.5 rad: det A changes sign on segment 1
+    _set_end(c, 0, 2, float.fromhex(c["segments"][0]["end"][2][0]) + 1.5)
+
+
+def _tamper_waypoint_x(c):  # 30 length units away: the legs leave [10, 32]
+    _set_end(c, 0, 0, float.fromhex(c["segments"][0]["end"][0][0]) + 30.0)
+
+
+def _tamper_discontinuous(c):  # segment 2 starts 1e-9 away from where segment 1 ends
+    v = float.fromhex(c["segments"][1]["start"][1][0]) + 1e-9
+    c["segments"][1]["start"][1] = [v.hex(), v.hex()]
+
+
+def _tamper_piece_boundary(c):  # a gap in the pieces of the segment with the most pieces
+    seg = max(c["segments"], key=lambda s: len(s["pieces"]))
+    assert len(seg["pieces"]) > 1
+    seg["pieces"][0][1] = (float.fromhex(seg["pieces"][0][1]) * 0.75).hex()
+
+
+def _tamper_last_piece(c):  # the pieces stop short of t = 1
+    c["segments"][-1]["pieces"][-1][1] = (0.875).hex()
+
+
+def _tamper_aspect(c):
+    c["aspect"], c["det_sign"] = "WA2", -1
+
+
+def _tamper_det_sign(c):
+    c["det_sign"] = -1
+
+
+def _tamper_joint_vector(c):
+    c["rho"][1] = _bump_digit(c["rho"][1])
+
+
+def _tamper_solution_number(c):
+    c["from"] = 1
+
+
+def _tamper_phi_turns(c):
+    c["phi_turns"] += 1
+
+
+@pytest.mark.parametrize("tamper, why", [
+    (_tamper_waypoint_phi, "piece"),
+    (_tamper_waypoint_x, "a leg proved beyond its limit"),
+    (_tamper_discontinuous, "not continuous"),
+    (_tamper_piece_boundary, "do not tile [0, 1]"),
+    (_tamper_last_piece, "do not tile [0, 1]"),
+    (_tamper_aspect, "det A is not proved < 0"),
+    (_tamper_det_sign, "det_sign"),
+    (_tamper_joint_vector, "Krawczyk"),
+    (_tamper_solution_number, "not inside the box of solution 1"),
+    (_tamper_phi_turns, "goal_box"),
+])
+def test_tamper_trajectory(cert_dir, tmp_path, capsys, tamper, why):
+    d = _copy(cert_dir, tmp_path)
+    doc = _load(d, "trajectory.json")
+    tamper(doc["claims"][0])
+    _save(d, "trajectory.json", doc)
+    line = _refused(d, capsys, "trajectory.json", doc["claims"][0]["id"])
+    assert why in line, line

@@ -57,6 +57,23 @@ Claim fields by kind (``id`` is unique within its file):
     ``[{"index", "box", "labels": {"W": 1|2|3, "det_positive": 1|2|3}}]``; the
     indices are :func:`intervalkin.checker.sample_indices` (seed, population,
     sample_size).  Labels: 1 OUTSIDE, 2 INSIDE, 3 BOUNDARY (claims nothing).
+``trajectory``
+    one claim per path (id ``"I-J"``): ``rho`` (3 exact strings), ``from``,
+    ``to`` (solution numbers, 1-based in increasing phi, as ``intervalkin dkp``
+    lists them), ``aspect``, ``det_sign``, ``phi0`` and ``solutions`` (the
+    complete solution list of rho, as for dkp: it fixes the numbering),
+    ``start_box``, ``goal_box`` (enclosures of the two end solutions, phi in
+    [-pi, pi]), ``phi_turns`` (the path reaches the goal at its phi plus
+    2 pi phi_turns: phi is unwrapped along the path), ``waypoints`` (m rows
+    [x, y, phi] as hex strings, for the reader) and ``segments``:
+    ``[{"start", "end", "pieces"}]`` exactly as
+    :meth:`~intervalkin.trajectory.Trajectory.certificate` gives them: end point
+    enclosures ``[[lo, hi]] * 3`` and pieces ``[[t0, t1], ...]``, every number a
+    binary64 written EXACTLY as a hex string (``float.hex``).  Proves: the
+    straight segments, each from any point of its start enclosure to any point
+    of its end enclosure, keep det A of the aspect's sign and every leg within
+    its limits; they join end to end from the exact start solution to the
+    exact goal solution.
 ``counts``
     one claim per count: ``name`` (``aspects``, ``basic_regions``,
     ``uniqueness_domains``), ``lower_bound``, ``found`` (the library's number,
@@ -92,6 +109,7 @@ __all__ = [
     "aspect_distinct_claims",
     "region_distinct_claims",
     "box_labels_claim",
+    "trajectory_claims",
     "counts_claims",
 ]
 
@@ -354,6 +372,52 @@ def box_labels_claim(paving, sample: int, seed: int, precision: int = 128) -> di
     }
 
 
+def trajectory_claims(geometry: Geometry, trajectories: Sequence,
+                      precision: int = 128) -> tuple[list[dict], list[dict]]:
+    """One ``trajectory`` claim per certified :class:`~intervalkin.trajectory.Trajectory` (checked); and the omitted.
+
+    The segments are copied from :meth:`Trajectory.certificate` (exact hex
+    floats); the solution list of the joint vector (which numbers the
+    solutions) is padded if the checker's Krawczyk test needs it, the start
+    and goal boxes never are (they are the enclosures the segments start and
+    end in).  An uncertified trajectory, or one the checker refuses, is omitted.
+    """
+    claims, omitted = [], []
+    for tr in trajectories:
+        cid = f"{tr.i_from}-{tr.i_to}"
+        if not tr.certified:
+            omitted.append({"what": f"trajectory {cid}", "why": f"the path is not certified: {tr.reason}"})
+            continue
+        sols = list(tr.solutions)
+        if not sols or any(s.status != "unique" or s.det_sign == 0 for s in sols):
+            omitted.append({"what": f"trajectory {cid}", "why": "the solutions of rho are not all certified"})
+            continue
+        cert = tr.certificate()
+        hx = lambda v: float(v).hex()  # noqa: E731
+        claim = {
+            "id": cid,
+            "rho": [_exact(r) for r in tr.rho],
+            "from": int(tr.i_from),
+            "to": int(tr.i_to),
+            "aspect": tr.aspect,
+            "det_sign": int(tr.sign),
+            "phi0": 0.0,
+            "solutions": [{"box": _box_json(s.box), "det_sign": int(s.det_sign)} for s in sols],
+            "start_box": _box_json(sols[tr.i_from - 1].box),
+            "goal_box": _box_json(sols[tr.i_to - 1].box),
+            "phi_turns": int(tr.phi_turns),
+            "waypoints": [[hx(v) for v in w] for w in tr.waypoints],
+            "segments": [{k: s[k] for k in ("start", "end", "pieces")} for s in cert["segments"]],
+            "statement": (f"for q = ({_rho_text(tr.rho)}), the straight segments between the waypoints move the "
+                          f"platform from solution {tr.i_from} to solution {tr.i_to} with det A "
+                          f"{'> 0' if tr.sign > 0 else '< 0'} and every leg within its limits all along: "
+                          f"a non-singular change of assembly mode in {tr.aspect}"),
+        }
+        got, why = _certified(geometry, "trajectory", claim, precision)
+        (claims.append(got) if got else omitted.append({"what": f"trajectory {cid}", "why": why}))
+    return claims, omitted
+
+
 def counts_claims(analysis, aspect_refs: Sequence[str], solve_refs: Sequence[str]) -> list[dict]:
     """The declared counts of :meth:`RegionAnalysis.counts` with the claims supporting their lower bounds."""
     c = analysis.counts()
@@ -411,6 +475,7 @@ def write_certificates(
     box_sample: int = 200,
     seed: int = 0,
     precision: int = 128,
+    trajectories: Sequence = (),
 ) -> list[Path]:
     """Write the certificate folder of the given results; return the paths written (index last).
 
@@ -427,6 +492,8 @@ def write_certificates(
         when ``regions`` is None.
     box_sample : number of boxes in the ``box_labels`` sample (0: no sample).
     seed : seed of the sample (:func:`intervalkin.checker.sample_indices`).
+    trajectories : :class:`~intervalkin.trajectory.Trajectory` objects ->
+        ``trajectory.json`` (uncertified ones are omitted).
     precision : arb bits the checker starts with (raised per claim when needed).
 
     Every solve claim is re-checked with :mod:`intervalkin.checker` before it
@@ -466,6 +533,10 @@ def write_certificates(
         files["region_distinct"] = reg
     if pav is not None and box_sample > 0:
         files["box_labels"] = [box_labels_claim(pav, box_sample, seed, precision)]
+    if trajectories:
+        trj, om = trajectory_claims(geometry, trajectories, precision)
+        omitted += om
+        files["trajectory"] = trj
     if regions is not None:
         aspect_refs = [f"aspect_distinct.json#{c['id']}" for c in files.get("aspect_distinct", [])]
         solve_refs = ([f"joint_cell.json#{c['id']}" for c in files.get("joint_cell", [])]
