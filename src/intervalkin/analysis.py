@@ -421,15 +421,17 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
     st = Stages(quiet=quiet)
     a = analyse(geometry, depth, st, refine_to=refine_to)
     summary = write_chain(a, out, figures=figures, stages=st)
+    trajs = []
+    if paper:  # before the certificates, which re-check these paths
+        st.start("certified trajectories between Table 1's solutions 2, 3, 6")
+        summary["trajectories"], trajs = _paper_trajectories(a, out, summary["files"])
+        st.done()
     if certificates:
         st.start("certificates")
-        cert_files = _write_certificates(a, out)
+        cert_files = _write_certificates(a, out, trajectories=trajs)
         st.done()
         summary["files"] += cert_files
     if paper:
-        st.start("certified trajectories between Table 1's solutions 2, 3, 6")
-        summary["trajectories"] = _paper_trajectories(a, out, summary["files"])
-        st.done()
         st.start("paper report")
         from .paper import write_report
 
@@ -450,8 +452,12 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
     return 0
 
 
-def _write_certificates(a: Analysis, out: Path) -> list[str]:
-    """Certificates of the claims (written by :mod:`intervalkin.certificates` when present)."""
+def _write_certificates(a: Analysis, out: Path, trajectories=()) -> list[str]:
+    """Certificates of the claims (written by :mod:`intervalkin.certificates` when present).
+
+    ``trajectories``: :class:`~intervalkin.trajectory.Trajectory` objects, written
+    as ``trajectory`` claims (the paper run passes its three Table 1 paths).
+    """
     try:
         from .certificates import write_certificates
     except ImportError:  # pragma: no cover - the certificates module ships with the package
@@ -465,7 +471,7 @@ def _write_certificates(a: Analysis, out: Path) -> list[str]:
 
         dkp_results.append(solve(a.geometry, parse_joint_vector(a.geometry, TABLE1_RHO)))
     paths = write_certificates(out / "certificates", a.geometry, dkp_results=dkp_results, joint=a.joint,
-                               regions=a.regions)
+                               regions=a.regions, trajectories=trajectories)
     return [f"certificates/{Path(p).name}" for p in paths]
 
 
@@ -576,13 +582,17 @@ def _label_from_npz(folder: Path, exact) -> dict:
     return res
 
 
-def _paper_trajectories(a: Analysis, out: Path, files: list[str]) -> list[dict]:
-    """Certified non-singular paths between Table 1's solutions 2, 3 and 6 (paper section 3.2, Fig. 13)."""
+def _paper_trajectories(a: Analysis, out: Path, files: list[str]) -> tuple[list[dict], list]:
+    """Certified non-singular paths between Table 1's solutions 2, 3 and 6 (paper section 3.2, Fig. 13).
+
+    Returns the report entries (one per pair, failures included) and the
+    :class:`~intervalkin.trajectory.Trajectory` objects found (for the certificates).
+    """
     from .errors import IntervalkinError
     from .paper import TABLE1_RHO
     from .trajectory import trajectory, write_trajectory
 
-    done = []
+    done, found = [], []
     for i, j in ((2, 3), (2, 6), (3, 6)):
         try:
             tr = trajectory(a.geometry, TABLE1_RHO, i, j, analysis=a.regions, joint=a.joint)
@@ -596,7 +606,8 @@ def _paper_trajectories(a: Analysis, out: Path, files: list[str]) -> list[dict]:
         doc["summary"] = tr.summary()
         doc["folder"] = f"trajectories/{i}-{j}"
         done.append(doc)
-    return done
+        found.append(tr)
+    return done, found
 
 
 def run_trajectory(geometry_path, rho, i_from: int, i_to: int, depth: int = 7, out=None,
