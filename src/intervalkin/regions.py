@@ -310,18 +310,27 @@ def _solve_located(geometry, q, sign, locator):
     return [(locator.piece_of(np.asarray(s.box)), np.asarray(s.box)) for s in res.solutions if s.det_sign == sign]
 
 
-def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tries: int = 12, seed: int = 0,
-                   max_pieces: int = 40):
-    """Sheet of each piece (-1 undecided) by certified elimination, and the witnesses used.
+def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tries: int = 12, seed: int = 0):
+    """Sheet of each piece (-1 undecided) by certified continuation, and the witnesses.
 
-    Above a cell C with k = n_a(C) solutions of aspect a there are exactly k sheets.
-    k = 1: every piece is in the one sheet.  Otherwise a reference joint vector q0
-    in C whose k solutions lie in k pieces names the sheets (the ``max_pieces``
-    largest pieces of each cell and aspect are tried); a piece R is then put
-    in sheet s when some q in C has one solution in R and its other k - 1
-    solutions in pieces of k - 1 known sheets other than s (the solutions of q lie
-    in k different sheets, by Theorem 1).
+    Above a cell C with k = n_a(C) solutions of aspect a there are exactly k sheets
+    (proofs/lemma-theorem1-distinctness.md (d)).  k = 1: every piece is in the one
+    sheet.  Otherwise the certified solutions of the cell's witness q0 (a voxel
+    centre) name the sheets 0..k-1 in the solver's order; a piece holding one of
+    them is in that sheet; every other piece is identified by continuation
+    (:func:`continuation.identify_sheets`): a certified solution inside one of
+    its boxes is tracked, with parameter Krawczyk steps, along a path of cell
+    voxels to where the k reference solutions of q0 have been tracked, and its
+    box there holds exactly one of them (proofs/lemma-sheet-continuation.md).
+    A piece whose track cannot be certified keeps -1; it is never guessed.
+
+    The witnesses (distinct pieces holding the solutions of one joint vector)
+    come from the joint vector of the cell, among the witness and ``tries``
+    random voxel centres, whose solutions land in the most pieces.
     """
+    from .continuation import identify_sheets
+    from .dkp import solve
+
     rng = np.random.default_rng(seed)
     locator = _Locator(paving, piece)
     sheet = np.full(len(piece_cell), -1, dtype=np.int32)
@@ -332,6 +341,7 @@ def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tri
         groups.setdefault((int(c), a), []).append(pid)
     vol = paving.volume()
     piece_vol = np.bincount(piece[piece >= 0], weights=vol[piece >= 0], minlength=len(piece_cell))
+    pending: dict[int, list[str]] = {}
     for (cid, a), pids in sorted(groups.items()):
         cell = joint.cells[cid]
         k = cell.n_wa1 if a == "WA1" else cell.n_wa2
@@ -340,7 +350,9 @@ def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tri
         if k == 1:
             sheet[pids] = 0
             continue
-        # reference: the joint vector whose solutions land in the most pieces
+        if cell.witness is not None:
+            pending.setdefault(cid, []).append(a)
+        # witnesses of distinctness: the joint vector whose solutions land in the most pieces
         best = None
         candidates = ([cell.witness] if cell.witness else []) + [_point_in_cell(joint, rng, cid) for _ in range(tries)]
         for q in candidates:
@@ -355,37 +367,35 @@ def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tri
         if best is None:
             continue
         q0, landed, loc = best
-        if len(set(landed)) != len(landed):
-            continue  # two solutions in one piece would contradict Theorem 1: leave undecided
-        for s_idx, p in enumerate(landed):
-            sheet[p] = s_idx
-        if len(landed) >= 2:
+        if len(landed) >= 2 and len(set(landed)) == len(landed):
             witnesses.append(Witness(tuple(q0), cid, a, tuple(landed),
                                      tuple(tuple((float(x), float(y)) for x, y in b) for p, b in loc if p >= 0)))
-        known = set(range(len(landed)))
-        # eliminate, largest pieces first; a few passes as new sheets become known
-        for _ in range(3):
-            progress = False
-            for p in sorted(pids, key=lambda t: -piece_vol[t])[:max_pieces]:
-                if sheet[p] >= 0:
-                    continue
-                boxes = np.flatnonzero(piece == p)
-                b = boxes[np.argmax(vol[boxes])]
-                centre = 0.5 * (paving.lo[b] + paving.hi[b])
-                rho = _approx_g(geometry, centre)
-                q = tuple(Fraction(float(r)).limit_denominator(10**12) for r in rho)
-                if joint.cell_at(q) != cid:
-                    continue
-                loc = _solve_located(geometry, q, sign_of[a], locator)
-                if loc is None or p not in [x for x, _ in loc]:
-                    continue
-                others = [sheet[x] for x, _ in loc if x != p and x >= 0 and sheet[x] >= 0]
-                free = known - set(others) if len(known) == k else set(range(k)) - set(others)
-                if len(others) == k - 1 and len(set(others)) == k - 1 and len(free) == 1:
-                    sheet[p] = free.pop()
-                    progress = True
-            if not progress:
-                break
+    # the largest box of each piece starts its track
+    has = np.flatnonzero(piece >= 0)
+    order = has[np.lexsort((-vol[has], piece[has]))]
+    first = np.ones(order.size, dtype=bool)
+    first[1:] = piece[order[1:]] != piece[order[:-1]]
+    start_box = np.full(len(piece_cell), -1, dtype=np.int64)
+    start_box[piece[order[first]]] = order[first]
+    for cid, aspects in sorted(pending.items()):
+        q0 = joint.cells[cid].witness
+        res = solve(geometry, q0)
+        if not res.complete or any(s.status != "unique" for s in res.solutions):
+            continue
+        references = {a: [np.asarray(s.box) for s in res.solutions if s.det_sign == sign_of[a]] for a in aspects}
+        todo = []
+        for a in aspects:
+            for s_idx, b in enumerate(references[a]):
+                p = locator.piece_of(b)  # the piece holding solution s of q0 is in sheet s
+                if p >= 0 and piece_aspect[p] == a and int(piece_cell[p]) == cid:
+                    sheet[p] = s_idx
+            todo += [p for p in groups[(cid, a)] if sheet[p] < 0]
+        todo.sort(key=lambda t: -piece_vol[t])
+        if not todo:
+            continue
+        boxes = paving.boxes[start_box[todo]]
+        got, _ = identify_sheets(geometry, joint, cid, q0, references, boxes, [piece_aspect[p] for p in todo])
+        sheet[todo] = np.where(got >= 0, got, sheet[todo])
     return sheet, tuple(witnesses)
 
 
