@@ -167,3 +167,142 @@ def test_label_of_table1_solutions(chain):
     assert len(seen) == len(set(seen))
     out = label_pose(ra, ("40", "40", "0"))
     assert out["boxes"] == 0 or out["in_workspace"] in ("no", "undecided")
+
+
+# --------------------------------------------------------------------------------------
+# Sheets by certified continuation (proofs/lemma-sheet-continuation.md)
+# --------------------------------------------------------------------------------------
+def test_nearly_every_piece_has_its_sheet(chain):
+    """Continuation names the sheet of almost every piece, by count and by volume."""
+    jp, ra = chain
+    vol = ra.paving.volume()
+    has = ra.piece >= 0
+    n_pieces = int(ra.piece.max()) + 1
+    piece_vol = np.bincount(ra.piece[has], weights=vol[has], minlength=n_pieces)
+    assigned = np.zeros(n_pieces, dtype=bool)
+    assigned[ra.piece[has & (ra.region >= 0)]] = True
+    assert assigned.mean() > 0.8
+    assert piece_vol[assigned].sum() > 0.9 * piece_vol.sum()
+    for c in ra.consistency:
+        assert c["sheets_with_boxes"] <= c["expected"]
+
+
+def test_sheets_of_pieces_match_the_solutions_of_their_cell(chain, paper_geometry):
+    """A piece holding a certified solution of some q in its cell is in the sheet of that solution.
+
+    Independent of the continuation: the solutions of q, sorted by the region of
+    the piece they land in, must be in pairwise different sheets (one per sheet).
+    """
+    jp, ra = chain
+    p = ra.paving
+    rng = np.random.default_rng(11)
+    checked = 0
+    multi = [r.cell for r in ra.regions if r.sheet >= 1]
+    for _ in range(60):
+        cid = multi[rng.integers(len(multi))]
+        vox = np.argwhere(jp.cell == cid)
+        v = vox[rng.integers(len(vox))]
+        q = tuple(jp.rho_min[i] + (int(v[i]) + Fraction(int(rng.integers(1, 99)), 100)) * jp.step[i] for i in range(3))
+        res = solve(paper_geometry, q)
+        assert res.complete
+        for sign, name in ((1, "WA1"), (-1, "WA2")):
+            sheets = []
+            for s in res.solutions:
+                if s.det_sign != sign:
+                    continue
+                box = np.asarray(s.box)
+                i = p.locate_boxes(box[None])[0]
+                if i >= 0 and ra.region[i] >= 0:
+                    r = ra.regions[ra.region[i]]
+                    assert r.cell == cid and r.aspect == name
+                    sheets.append(r.sheet)
+            assert len(sheets) == len(set(sheets))
+            checked += len(sheets)
+    assert checked > 50
+
+
+def _fold_segment(geometry):
+    """A singular pose X_s of W, q_s = g(X_s), and a joint step dq that crosses g(S) there.
+
+    Along q_s + s dq the two solutions near X_s exist for s < 0 and merge at s = 0.
+    """
+    from intervalkin.kinematics import approx_det_a, approx_inverse_kinematics, approx_jacobian
+
+    xs = np.linspace(-30, 30, 6001)
+    P = np.stack([xs, np.full_like(xs, -10.0), np.full_like(xs, 0.3)], axis=1)
+    d = approx_det_a(geometry, P)
+    for i in np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:])):
+        a, b = P[i].copy(), P[i + 1].copy()
+        for _ in range(60):
+            mid = 0.5 * (a + b)
+            if np.sign(approx_det_a(geometry, mid[None])[0]) == np.sign(approx_det_a(geometry, a[None])[0]):
+                a = mid
+            else:
+                b = mid
+        x_s = 0.5 * (a + b)
+        q_s = approx_inverse_kinematics(geometry, x_s[None])[0]
+        if np.all((q_s > 12) & (q_s < 30)):
+            break
+    else:  # pragma: no cover
+        pytest.fail("no singular pose on the search line")
+    u, _, _ = np.linalg.svd(approx_jacobian(geometry, x_s[None])[0])
+    dq = u[:, 2] / (2 * q_s)  # moves rho^2 along the left null vector of A: across the fold
+    dq = 0.02 * dq / np.linalg.norm(dq)
+    return x_s, q_s, dq
+
+
+def test_parameter_krawczyk_refuses_steps_across_a_fold(paper_geometry):
+    """Krawczyk over [t0, t1] holding the fold is refused; tracking stops before it, never past it."""
+    from intervalkin import continuation as C
+    from intervalkin.interval import Interval
+
+    x_s, q_s, dq = _fold_segment(paper_geometry)
+    side = None
+    for s in (-1.0, 1.0):
+        p, conv = C._newton(paper_geometry, x_s[None] + 0.05, (q_s + s * dq)[None], iters=40)
+        if conv[0] and np.max(np.abs(p[0] - x_s)) < 2.0:
+            side, start = s, p[0]
+    assert side is not None
+    qa = Interval.point((q_s + side * dq)[None])
+    qb = Interval.point((q_s - side * dq)[None])  # q(1/2) = q_s is on g(S)
+    # any box around the singular pose, over a parameter range holding t = 1/2: refused
+    for r in (1e-3, 1e-2, 0.1, 1.0):
+        lo, hi = x_s[None] - r, x_s[None] + r
+        ok, _, _ = C.krawczyk_segment(paper_geometry, lo, hi, qa, qb, np.array([0.4]), np.array([0.6]))
+        assert not ok[0]
+    # from the side with solutions, across the fold: the track must give up
+    z = np.stack([start - 1e-9, start + 1e-9])
+    tr = C.track(paper_geometry, C.new_tracks(qa, qb, start[None], z[0][None], z[1][None]))
+    assert tr.status[0] == -1 and tr.t[0] < 0.5
+    # the same solution tracked to just before the fold: certified, and it ends near the fold
+    near = Interval.point((q_s + side * 0.1 * dq)[None])
+    tr = C.track(paper_geometry, C.new_tracks(qa, near, start[None], z[0][None], z[1][None]))
+    assert tr.status[0] == 1
+    assert np.all(tr.x_lo[0] <= tr.p[0]) and np.all(tr.p[0] <= tr.x_hi[0])
+
+
+def test_tracked_box_holds_the_certified_solution_at_the_end(paper_geometry):
+    """Tracks between two exact joint vectors end in boxes holding exactly the solver's solutions there."""
+    from intervalkin import continuation as C
+    from intervalkin.interval import Interval
+
+    qa = (Fraction(15), Fraction(20), Fraction(18))
+    qb = (Fraction(31, 2), Fraction(39, 2), Fraction(18))
+    ra, rb = solve(paper_geometry, qa), solve(paper_geometry, qb)
+    assert ra.complete and rb.complete and len(ra.solutions) == len(rb.solutions)
+    m = len(ra.solutions)
+    A = Interval.point(np.tile([float(v) for v in qa], (m, 1)))
+    B = Interval.point(np.tile([float(v) for v in qb], (m, 1)))
+    boxes = np.array([np.asarray(s.box) for s in ra.solutions])
+    tr = C.track(paper_geometry, C.new_tracks(A, B, boxes.mean(axis=2), boxes[:, :, 0], boxes[:, :, 1]))
+    assert np.all(tr.status == 1)
+    ends = np.array([np.asarray(s.box) for s in rb.solutions])
+    seen = []
+    for i in range(m):
+        inside, apart = C.compare_mod_2pi(np.repeat(tr.x_lo[i:i + 1], m, 0), np.repeat(tr.x_hi[i:i + 1], m, 0),
+                                          ends[:, :, 0], ends[:, :, 1])
+        assert inside.sum() == 1 and apart.sum() == m - 1  # each track ends on exactly one solution
+        j = int(np.flatnonzero(inside)[0])
+        assert ra.solutions[i].det_sign == rb.solutions[j].det_sign  # no fold on the way: same aspect
+        seen.append(j)
+    assert sorted(seen) == list(range(m))

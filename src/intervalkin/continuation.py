@@ -382,13 +382,15 @@ def _shift_phi(lo: np.ndarray, hi: np.ndarray, turns: np.ndarray):
 
 
 def compare_mod_2pi(x_lo, x_hi, z_lo, z_hi):
-    """(inside, apart): [z] + 2 pi k inside [x] for some k; [z] + 2 pi k misses [x] for every k.
+    """(inside, apart): [z] + 2 pi k inside [x] for some integer k; [z] + 2 pi k misses [x] for every k.
 
-    Arrays (m, 3); x must be narrower than pi in phi for ``apart`` to be claimed.
+    Arrays (m, 3).  Only the three k nearest the difference of the phi centres
+    are tried: with both boxes narrower than 3 in phi, every other k puts the
+    two phi ranges more than 3 pi - 3 apart, so ``apart`` is claimed only then.
     """
     k0 = np.rint(((x_lo[:, 2] + x_hi[:, 2]) - (z_lo[:, 2] + z_hi[:, 2])) / (4 * np.pi)).astype(np.int64)
     inside = np.zeros(len(k0), dtype=bool)
-    apart = (x_hi[:, 2] - x_lo[:, 2]) < 3.0
+    apart = ((x_hi[:, 2] - x_lo[:, 2]) < 3.0) & ((z_hi[:, 2] - z_lo[:, 2]) < 3.0)
     for dk in (-1, 0, 1):
         lo2, hi2 = _shift_phi(z_lo, z_hi, k0 + dk)
         inside |= np.all((x_lo <= lo2) & (hi2 <= x_hi), axis=1)
@@ -600,8 +602,9 @@ def identify_sheets(geometry: Geometry, joint, cid: int, root_q, references: dic
     sign_of = {"WA1": 1, "WA2": -1}
     labels = [(a, s_) for a in sorted(references) for s_ in range(len(references[a]))]
     root_idx = tuple(int((root_q[i] - joint.rho_min[i]) / joint.step[i] - Fraction(1, 2)) for i in range(3))
-    assert all(joint.rho_min[i] + (root_idx[i] + Fraction(1, 2)) * joint.step[i] == root_q[i] for i in range(3)), \
-        "the reference joint vector must be a voxel centre"
+    if not all(joint.rho_min[i] + (root_idx[i] + Fraction(1, 2)) * joint.step[i] == root_q[i] for i in range(3)):
+        rep.start_failed = m  # the reference must be a voxel centre: nothing is decided
+        return sheet, rep
     root = int((root_idx[0] * n + root_idx[1]) * n + root_idx[2])
 
     # 1. a certified solution inside each start box, and its voxel
