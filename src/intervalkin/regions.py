@@ -16,6 +16,10 @@ rebuilt on certified pavings.
   maps into unmarked voxels of one joint cell (its index range is a block of
   unmarked voxels); adjacent boxes share a face, so a whole region maps into
   one cell, which the code checks.
+* Sheets: above a cell C with k solutions of an aspect there are exactly k
+  sheets (the basic regions over C); the k solutions of the cell's witness name
+  them, and the sheet of each piece is found by certified continuation inside C
+  (:mod:`intervalkin.continuation`, proofs/lemma-sheet-continuation.md).
 * Distinctness (DESIGN.md section 6): two regions are certified different when
   (a) their aspects differ (opposite certified det A signs); (b) their cells have
   different certified counts (different basic components); or (c) a joint
@@ -397,12 +401,6 @@ def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tri
         got, _ = identify_sheets(geometry, joint, cid, q0, references, boxes, [piece_aspect[p] for p in todo])
         sheet[todo] = np.where(got >= 0, got, sheet[todo])
     return sheet, tuple(witnesses)
-
-
-def _approx_g(geometry, pose):
-    from .kinematics import approx_inverse_kinematics
-
-    return approx_inverse_kinematics(geometry, np.asarray(pose)[None, :])[0]
 
 
 # --------------------------------------------------------------------------------------
