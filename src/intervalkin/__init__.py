@@ -12,6 +12,7 @@ dkp           certified direct kinematics: every solution, proved unique, comple
 predicates    W, the sign of det A and the aspects as tri-state labels over arrays of boxes
 export        atomic npz / JSON / VTK writers          figures   PNG renderings
 joint         joint space: outer enclosure of g(S), cells of certified solution count
+continuation  certified tracking of solutions along joint-space paths (sheets of a cell)
 regions       characteristic surfaces, basic regions, basic components, uniqueness domains
 certificates  claim files written from the results above
 trajectory    certified non-singular assembly-mode changing paths

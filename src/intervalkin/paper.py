@@ -378,7 +378,8 @@ def write_report(analysis, summary: dict, out, timings: dict) -> str:
             if "folder" in t:
                 a(f"![Path {t['from']} -> {t['to']} in the workspace]({t['folder']}/trajectory_workspace_xy.png)\n")
                 a(f"![Path {t['from']} -> {t['to']} in joint space]({t['folder']}/trajectory_joint.png)\n")
-        a("The animations are in `trajectories/*/trajectory_animation.gif`.\n")
+        a("The animations are in `trajectories/*/trajectory_animation.gif`. Each certified path is also a claim "
+          "in `certificates/trajectory.json`, which `intervalkin verify` re-proves piece by piece in arb.\n")
 
     a("## Depth, time, undecided volumes\n")
     for k, v in summary["timings_seconds"].items():

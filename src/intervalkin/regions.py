@@ -57,7 +57,7 @@ import numpy as np
 
 from .geometry import Geometry
 from .joint import JointPaving, singular_image
-from .paving import Label, Paving, component_labels, pave_multi, shares_face, workspace_paving_domain
+from .paving import Label, Paving, component_labels, grow_labels, pave_multi, shares_face, workspace_paving_domain
 from .predicates import aspect_labels, det_sign_predicate, workspace_predicate
 
 __all__ = [
@@ -406,24 +406,6 @@ def _assign_sheets(geometry, paving, piece, piece_aspect, piece_cell, joint, tri
 # --------------------------------------------------------------------------------------
 # Region adjacency across the characteristic surfaces, uniqueness domains
 # --------------------------------------------------------------------------------------
-def _grow_into_layer(n: int, edges: np.ndarray, seeds: np.ndarray, layer: np.ndarray, max_steps: int = 10_000) -> np.ndarray:
-    """Multi-source growth of ids into the layer boxes (nearest seed in the box graph)."""
-    lab = seeds.copy()
-    edges = edges[:, layer[edges[0]] | layer[edges[1]]]  # edges inside the regions never change a label
-    u, v = edges
-    for _ in range(max_steps):
-        a = (lab[u] >= 0) & (lab[v] < 0) & layer[v]
-        b = (lab[v] >= 0) & (lab[u] < 0) & layer[u]
-        if not (np.any(a) or np.any(b)):
-            break
-        new = np.full(n, np.iinfo(np.int64).max, dtype=np.int64)
-        np.minimum.at(new, v[a], lab[u[a]])
-        np.minimum.at(new, u[b], lab[v[b]])
-        upd = new != np.iinfo(np.int64).max
-        lab[upd] = new[upd]
-    return lab
-
-
 def region_adjacency(paving: Paving, edges: np.ndarray, region: np.ndarray) -> set[tuple[int, int]]:
     """Pairs of basic regions of one aspect adjacent across its characteristic surface.
 
@@ -438,7 +420,7 @@ def region_adjacency(paving: Paving, edges: np.ndarray, region: np.ndarray) -> s
         in_aspect = paving.labels[name] == Label.INSIDE
         seeds = np.where(in_aspect & (region >= 0), region, -1).astype(np.int64)
         inner = edges[:, in_aspect[edges[0]] & in_aspect[edges[1]]]
-        lab = _grow_into_layer(n, inner, seeds, in_aspect & (region < 0))
+        lab = grow_labels(n, inner, seeds, in_aspect & (region < 0))
         u, v = inner
         m = (lab[u] >= 0) & (lab[v] >= 0) & (lab[u] != lab[v]) & in_aspect[u] & in_aspect[v]
         for a, b in set(zip(lab[u[m]].tolist(), lab[v[m]].tolist())):
