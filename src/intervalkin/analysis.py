@@ -537,16 +537,25 @@ def run_label(geometry_path, pose, depth: int, source=None, as_json: bool = Fals
         raise InputError(f"pose: expected three numbers X Y PHI, got {' '.join(map(str, pose))}") from None
     if source is not None:
         res = _label_from_npz(Path(source), exact)
+        res["pose"] = [str(v) for v in pose]
     else:
         geometry = geometry_from_option(geometry_path)
         from .regions import label_pose
 
         a = analyse(geometry, depth)
         res = label_pose(a.regions, [str(v) for v in pose])
+    if res["aspect"] in ("WA1", "WA2") and res["basic_region"] == "undecided":
+        res["note"] = ("certified inside the aspect, but the box holding the pose may meet a characteristic "
+                       "surface (its image meets the enclosure of g(S)), or its sheet is not identified; "
+                       "a deeper --depth may decide it")
+    elif res["in_workspace"] == "undecided":
+        res["note"] = "the box holding the pose is on the undecided layer of W or of det A = 0"
     if as_json:
         sys.stdout.write(json.dumps(res) + "\n")
     else:
-        for k in ("in_workspace", "aspect", "basic_region", "uniqueness_domain"):
+        for k in ("in_workspace", "aspect", "basic_region", "uniqueness_domain", "note"):
+            if k not in res:
+                continue
             sys.stdout.write(f"{k:<18} {res[k]}\n")
     return 0
 
