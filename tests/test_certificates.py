@@ -21,7 +21,10 @@ from intervalkin.joint import joint_paving
 from intervalkin.paving import Label
 from intervalkin.predicates import pave_workspace
 from intervalkin.regions import analyse_regions
+from intervalkin.geometry import load_geometry
 from intervalkin.trajectory import trajectory
+
+from .conftest import DATA
 
 TABLE1 = ["14.98", "15.38", "12.0"]
 
@@ -119,31 +122,13 @@ def test_table1_alone(tmp_path, paper_geometry, table1):
     assert max(b[1] - b[0] for s in claim["solutions"] for b in s["box"]) < 1e-9
 
 
-_CONCURRENT = """
-name = "legs concurrent at the origin"
-[base]
-a1 = [12, 16]
-a2 = [24, 10]
-a3 = [16, -12]
-[platform]
-b1 = [0, 0]
-b2 = [9, 1]
-b3 = [5, -10]
-[limits]
-rho_min = 5
-rho_max = 40
-"""
+
 
 
 def test_incomplete_solve_claims_only_its_unique_boxes(tmp_path, capsys):
     """q = (15, 13, 10) lies on g(S) (a double root): the claim says "not complete" and verifies as such;
     declaring it complete is refused, since the checker cannot isolate the double root."""
-    import decimal
-    import tomllib
-
-    from intervalkin.geometry import parse_geometry
-
-    g = parse_geometry(tomllib.loads(_CONCURRENT, parse_float=decimal.Decimal), source="inline")
+    g = load_geometry(DATA / "concurrent_legs.toml")
     res = solve(g, [Fraction(15), Fraction(13), Fraction(10)])
     assert not res.complete
     write_certificates(tmp_path, g, dkp_results=[res])

@@ -248,20 +248,7 @@ def test_joint_vector_on_image_of_singular_surface_never_wrong(paper_geometry, r
             assert len(approx_solve(paper_geometry, [float(r) for r in rho])) <= result.count
 
 
-_CONCURRENT = """
-name = "legs concurrent at the origin"
-[base]
-a1 = [12, 16]
-a2 = [24, 10]
-a3 = [16, -12]
-[platform]
-b1 = [0, 0]
-b2 = [9, 1]
-b3 = [5, -10]
-[limits]
-rho_min = 5
-rho_max = 40
-"""
+
 
 
 def _inline(text: str) -> Geometry:
@@ -271,7 +258,7 @@ def _inline(text: str) -> Geometry:
 def test_exactly_singular_joint_vector_is_not_certified():
     """B = (3,4), (12,5), (8,-6) with A_i on the rays from the origin: the three legs meet
     at the origin, det A = 0 exactly, q = (15, 13, 10) exactly on g(S): a double root."""
-    g = _inline(_CONCURRENT)
+    g = load_geometry(DATA / "concurrent_legs.toml")
     X = np.array([3.0, 4.0, math.atan2(1, 9)])
     assert np.allclose(approx_inverse_kinematics(g, X), [15, 13, 10])
     assert abs(approx_det_a(g, X)) < 1e-9

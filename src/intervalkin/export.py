@@ -144,25 +144,21 @@ def _b64(arr: np.ndarray) -> str:
     return base64.b64encode(np.uint64(len(data)).astype("<u8").tobytes() + data).decode("ascii")
 
 
-def write_vtu(path, lo: np.ndarray, hi: np.ndarray, cell_data: Mapping[str, np.ndarray]) -> Path:
-    """XML VTK UnstructuredGrid (.vtu) of hexahedra (cell type 12) with int32 cell data.
-
-    Arrays are inline base64 binary (fast to write, opens in ParaView).  Each box
-    is its own 8-point hexahedron (points are not shared), which keeps the writer
-    one vectorized pass; ParaView's "Clean" filter merges points if wanted.
-    """
-    n = lo.shape[0]
-    pts = _hex_points(np.asarray(lo, "<f8"), np.asarray(hi, "<f8")).astype("<f8")
+def _vtu_bytes(points: np.ndarray, connectivity: np.ndarray, offsets: np.ndarray,
+               cell_data: Mapping[str, np.ndarray]) -> bytes:
+    """An XML VTK UnstructuredGrid of hexahedra (cell type 12), arrays inline base64, int32 cell data."""
+    int_type = {"<i4": "Int32", "<i8": "Int64"}[connectivity.dtype.str]
+    n = offsets.size
     out = [
         '<?xml version="1.0"?>\n',
         '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n',
-        f'<UnstructuredGrid>\n<Piece NumberOfPoints="{8 * n}" NumberOfCells="{n}">\n',
+        f'<UnstructuredGrid>\n<Piece NumberOfPoints="{len(points)}" NumberOfCells="{n}">\n',
         '<Points>\n<DataArray type="Float64" NumberOfComponents="3" format="binary">\n',
-        _b64(pts), "\n</DataArray>\n</Points>\n<Cells>\n",
-        '<DataArray type="Int64" Name="connectivity" format="binary">\n',
-        _b64(np.arange(8 * n, dtype="<i8")), "\n</DataArray>\n",
-        '<DataArray type="Int64" Name="offsets" format="binary">\n',
-        _b64(8 * np.arange(1, n + 1, dtype="<i8")), "\n</DataArray>\n",
+        _b64(np.asarray(points, "<f8")), "\n</DataArray>\n</Points>\n<Cells>\n",
+        f'<DataArray type="{int_type}" Name="connectivity" format="binary">\n',
+        _b64(connectivity), "\n</DataArray>\n",
+        f'<DataArray type="{int_type}" Name="offsets" format="binary">\n',
+        _b64(offsets.astype(connectivity.dtype)), "\n</DataArray>\n",
         '<DataArray type="UInt8" Name="types" format="binary">\n',
         _b64(np.full(n, 12, dtype=np.uint8)), "\n</DataArray>\n</Cells>\n<CellData>\n",
     ]
@@ -171,7 +167,20 @@ def write_vtu(path, lo: np.ndarray, hi: np.ndarray, cell_data: Mapping[str, np.n
         out.append(_b64(np.asarray(arr).astype("<i4")))
         out.append("\n</DataArray>\n")
     out.append("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")
-    return atomic_write_bytes(path, "".join(out).encode())
+    return "".join(out).encode()
+
+
+def write_vtu(path, lo: np.ndarray, hi: np.ndarray, cell_data: Mapping[str, np.ndarray]) -> Path:
+    """XML VTK UnstructuredGrid (.vtu) of hexahedra (cell type 12) with int32 cell data.
+
+    Arrays are inline base64 binary (fast to write, opens in ParaView).  Each box
+    is its own 8-point hexahedron (points are not shared), which keeps the writer
+    one vectorized pass; ParaView's "Clean" filter merges points if wanted.
+    """
+    n = lo.shape[0]
+    pts = _hex_points(np.asarray(lo, "<f8"), np.asarray(hi, "<f8"))
+    data = _vtu_bytes(pts, np.arange(8 * n, dtype="<i8"), 8 * np.arange(1, n + 1, dtype="<i8"), cell_data)
+    return atomic_write_bytes(path, data)
 
 
 def write_vtu_paving(path, paving: Paving, cell_data: Mapping[str, np.ndarray], mask=None) -> Path:
@@ -192,27 +201,11 @@ def write_vtu_paving(path, paving: Paving, cell_data: Mapping[str, np.ndarray], 
     k = np.stack([uniq // ((nf + 1) * (nf + 1)), (uniq // (nf + 1)) % (nf + 1), uniq % (nf + 1)], axis=1)
     dom = np.asarray(paving.domain, dtype=np.float64)
     step = np.ldexp(dom[:, 1] - dom[:, 0], -paving.depth)
-    pts = np.where(k == nf, dom[:, 1], dom[:, 0] + k * step).astype("<f8")
+    pts = np.where(k == nf, dom[:, 1], dom[:, 0] + k * step)
     n = sel.size
-    out = [
-        '<?xml version="1.0"?>\n',
-        '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n',
-        f'<UnstructuredGrid>\n<Piece NumberOfPoints="{len(pts)}" NumberOfCells="{n}">\n',
-        '<Points>\n<DataArray type="Float64" NumberOfComponents="3" format="binary">\n',
-        _b64(pts), "\n</DataArray>\n</Points>\n<Cells>\n",
-        '<DataArray type="Int32" Name="connectivity" format="binary">\n',
-        _b64(inverse.astype("<i4")), "\n</DataArray>\n",
-        '<DataArray type="Int32" Name="offsets" format="binary">\n',
-        _b64(8 * np.arange(1, n + 1, dtype="<i4")), "\n</DataArray>\n",
-        '<DataArray type="UInt8" Name="types" format="binary">\n',
-        _b64(np.full(n, 12, dtype=np.uint8)), "\n</DataArray>\n</Cells>\n<CellData>\n",
-    ]
-    for name, arr in cell_data.items():
-        out.append(f'<DataArray type="Int32" Name="{name}" format="binary">\n')
-        out.append(_b64(np.asarray(arr)[sel].astype("<i4")))
-        out.append("\n</DataArray>\n")
-    out.append("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")
-    return atomic_write_bytes(path, "".join(out).encode())
+    data = _vtu_bytes(pts, inverse.astype("<i4"), 8 * np.arange(1, n + 1, dtype="<i4"),
+                      {name: np.asarray(arr)[sel] for name, arr in cell_data.items()})
+    return atomic_write_bytes(path, data)
 
 
 def read_vtu(path) -> dict[str, np.ndarray]:
