@@ -165,7 +165,7 @@ class Interval:
     def __truediv__(self, other: Operand) -> "Interval":
         o = _as_interval(other)
         zero_in = (o.lo <= 0) & (o.hi >= 0)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # inf bounds are still sound
             q1 = self.lo / o.lo
             q2 = self.lo / o.hi
             q3 = self.hi / o.lo
