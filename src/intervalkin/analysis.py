@@ -211,6 +211,19 @@ class Analysis:
     refinement: tuple = ()
 
 
+def _singular_and_joint(geometry, singular_depth: int, joint_depth: int, st: Stages):
+    """The singular layer at ``singular_depth`` and the joint cells on 2**joint_depth voxels per axis."""
+    from .joint import joint_paving, pave_singular_layer
+
+    st.start(f"singular layer (depth {singular_depth})")
+    sing = pave_singular_layer(geometry, singular_depth, progress=st.bar())
+    st.done()
+    st.start(f"joint space: enclosure of g(S) and certified cells (2^{joint_depth} voxels per axis)")
+    jp = joint_paving(geometry, sing, joint_depth)
+    st.done()
+    return sing, jp
+
+
 def analyse(geometry, depth: int = DEFAULT_DEPTH, stages: Stages | None = None, refine_to: int | None = None) -> Analysis:
     """Run the chain geometry -> singular layer -> joint cells -> regions -> uniqueness domains.
 
@@ -225,18 +238,12 @@ def analyse(geometry, depth: int = DEFAULT_DEPTH, stages: Stages | None = None, 
     limits, not the whole domain.  ``Analysis.refinement`` records each try and
     why it stopped.
     """
-    from .joint import joint_paving, pave_singular_layer
     from .regions import analyse_regions
 
     check_chain_depth(depth)
     st = stages or Stages(quiet=True)
     dw, ds, dj = chain_depths(depth)
-    st.start(f"singular layer (depth {ds})")
-    sing = pave_singular_layer(geometry, ds, progress=st.bar())
-    st.done()
-    st.start(f"joint space: enclosure of g(S) and certified cells (2^{dj} voxels per axis)")
-    jp = joint_paving(geometry, sing, dj)
-    st.done()
+    sing, jp = _singular_and_joint(geometry, ds, dj, st)
     st.start(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})")
     ra = analyse_regions(geometry, jp, dw, progress=st.bar())
     st.done()
@@ -493,7 +500,6 @@ def run_joint(geometry_path, depth: int, out, force: bool = False, quiet: bool =
     """``intervalkin joint``: the enclosure of g(S), the certified cells and their table."""
     from .export import atomic_write_bytes, write_json
     from .geometry import geometry_from_option
-    from .joint import joint_paving, pave_singular_layer
 
     if isinstance(depth, bool) or not isinstance(depth, int) or not 2 <= depth <= 8:
         raise InputError(f"--depth: expected an integer in 2..8 (voxels per axis 2**depth), got {depth!r}")
@@ -502,12 +508,7 @@ def run_joint(geometry_path, depth: int, out, force: bool = False, quiet: bool =
     st = Stages(quiet=quiet)
     ds = min(depth + 2, 10)
     check_depth(ds)
-    st.start(f"singular layer (depth {ds})")
-    sing = pave_singular_layer(geometry, ds, progress=st.bar())
-    st.done()
-    st.start(f"joint space cells (2^{depth} voxels per axis)")
-    jp = joint_paving(geometry, sing, depth)
-    st.done()
+    _, jp = _singular_and_joint(geometry, ds, depth, st)
     atomic_write_bytes(out / "pavings" / "joint.npz", _npz_bytes(jp.columns()))
     files = ["pavings/joint.npz"]
     if figures:

@@ -164,15 +164,16 @@ def _float(v: Any, what: str) -> float:
     return f
 
 
-def _box(obj: Any, what: str = "box") -> tuple[tuple[float, float], ...]:
-    """[[xlo, xhi], [ylo, yhi], [philo, phihi]] as binary64 numbers, lo <= hi."""
+def _box(obj: Any, what: str = "box", number=None) -> tuple[tuple[float, float], ...]:
+    """[[xlo, xhi], [ylo, yhi], [philo, phihi]] as binary64 numbers (or ``number``-parsed strings), lo <= hi."""
+    number = _float if number is None else number
     if not isinstance(obj, list) or len(obj) != 3:
         raise _Refused(f"{what}: expected [[xlo, xhi], [ylo, yhi], [philo, phihi]], got {obj!r}")
     out = []
     for j, pair in enumerate(obj):
         if not isinstance(pair, list) or len(pair) != 2:
             raise _Refused(f"{what}[{j}]: expected [lo, hi], got {pair!r}")
-        lo, hi = _float(pair[0], f"{what}[{j}][0]"), _float(pair[1], f"{what}[{j}][1]")
+        lo, hi = number(pair[0], f"{what}[{j}][0]"), number(pair[1], f"{what}[{j}][1]")
         if not lo <= hi:
             raise _Refused(f"{what}[{j}]: empty interval [{lo!r}, {hi!r}]")
         out.append((lo, hi))
@@ -738,17 +739,7 @@ def _hex(v: Any, what: str) -> float:
 
 def _hex_box(obj: Any, what: str) -> tuple[tuple[float, float], ...]:
     """[[xlo, xhi], [ylo, yhi], [philo, phihi]] as hex strings, lo <= hi."""
-    if not isinstance(obj, list) or len(obj) != 3:
-        raise _Refused(f"{what}: expected three [lo, hi] pairs of hex floats, got {obj!r}")
-    out = []
-    for j, pair in enumerate(obj):
-        if not isinstance(pair, list) or len(pair) != 2:
-            raise _Refused(f"{what}[{j}]: expected [lo, hi], got {pair!r}")
-        lo, hi = _hex(pair[0], f"{what}[{j}][0]"), _hex(pair[1], f"{what}[{j}][1]")
-        if not lo <= hi:
-            raise _Refused(f"{what}[{j}]: empty interval [{lo!r}, {hi!r}]")
-        out.append((lo, hi))
-    return tuple(out)
+    return _box(obj, what, number=_hex)
 
 
 def _inside(inner, outer) -> bool:
