@@ -20,3 +20,26 @@ def paper_geometry():
 @pytest.fixture
 def rng():
     return np.random.default_rng(20261121)
+
+
+def workspace_singular_boxes(geometry, depth: int) -> np.ndarray:
+    """Leaves of a workspace paving that may hold a singular point of W (det undecided, not outside W)."""
+    from intervalkin.paving import Label
+    from intervalkin.predicates import pave_workspace
+
+    p = pave_workspace(geometry, depth)
+    sel = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
+    return p.boxes[sel]
+
+
+def small_chain(geometry, workspace_depth: int, joint_depth: int, regions_depth: int | None = None,
+                max_solves: int = 400):
+    """A small real chain for tests: joint cells from a workspace paving, and (optionally) the regions."""
+    from intervalkin.joint import joint_paving
+    from intervalkin.regions import analyse_regions
+
+    jp = joint_paving(geometry, workspace_singular_boxes(geometry, workspace_depth), joint_depth,
+                      max_solves=max_solves)
+    if regions_depth is None:
+        return jp
+    return jp, analyse_regions(geometry, jp, regions_depth)

@@ -17,14 +17,10 @@ from intervalkin import checker
 from intervalkin.certificates import write_certificates
 from intervalkin.cli import main
 from intervalkin.dkp import _poly_t, _reduce, approx_solve, parse_joint_vector, solve
-from intervalkin.joint import joint_paving
-from intervalkin.paving import Label
-from intervalkin.predicates import pave_workspace
-from intervalkin.regions import analyse_regions
 from intervalkin.geometry import load_geometry
 from intervalkin.trajectory import trajectory
 
-from .conftest import DATA
+from .conftest import DATA, small_chain
 
 TABLE1 = ["14.98", "15.38", "12.0"]
 
@@ -37,11 +33,7 @@ def table1(paper_geometry):
 @pytest.fixture(scope="module")
 def chain(paper_geometry):
     """A small real chain (about 15 s): workspace depth 7, joint grid 2**5, regions at depth 7."""
-    p = pave_workspace(paper_geometry, 7)
-    sel = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
-    jp = joint_paving(paper_geometry, p.boxes[sel], 5)
-    ra = analyse_regions(paper_geometry, jp, 7)
-    return jp, ra
+    return small_chain(paper_geometry, 7, 5, 7)
 
 
 @pytest.fixture(scope="module")

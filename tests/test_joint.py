@@ -11,15 +11,13 @@ from flint import arb, ctx
 from intervalkin import kinematics as K
 from intervalkin.dkp import solve
 from intervalkin.joint import _mark, _range_sum, _summed_area, joint_paving, solution_count
-from intervalkin.paving import Label
-from intervalkin.predicates import pave_workspace
+
+from .conftest import small_chain
 
 
 @pytest.fixture(scope="module")
 def joint(paper_geometry):
-    p = pave_workspace(paper_geometry, 7)
-    sel = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
-    return joint_paving(paper_geometry, p.boxes[sel], 5, max_solves=200)
+    return small_chain(paper_geometry, 7, 5, max_solves=200)
 
 
 def _random_point_in_cell(jp, rng, cid):

@@ -56,6 +56,16 @@ def _arb_at(pt):
 fractions = st.lists(st.sampled_from([0.0, 1.0]) | st.floats(0, 1), min_size=3, max_size=3)
 
 
+
+def _arb_values(x, y, phi):
+    """rho_i^2 and det A at an arb point, at 128 bits."""
+    old = ctx.prec
+    ctx.prec = 128
+    try:
+        return rho_sq_arb(GEOM, x, y, phi), det_a_arb(GEOM, x, y, phi)
+    finally:
+        ctx.prec = old
+
 @settings(max_examples=250, deadline=None, derandomize=True)
 @given(pick=st.integers(0, 10**9), fr=fractions)
 def test_workspace_and_det_labels_hold_at_points(paving6, pick, fr):
@@ -64,13 +74,7 @@ def test_workspace_and_det_labels_hold_at_points(paving6, pick, fr):
     b = idx[pick % idx.size]
     box = np.stack([p.lo[b], p.hi[b]], -1)
     x, y, phi = _arb_at(_point(box, fr))
-    old = ctx.prec
-    ctx.prec = 128
-    try:
-        rs = rho_sq_arb(GEOM, x, y, phi)
-        det = det_a_arb(GEOM, x, y, phi)
-    finally:
-        ctx.prec = old
+    rs, det = _arb_values(x, y, phi)
     w = p.labels["W"][b]
     if w == Label.INSIDE:
         assert all(r >= lo and r <= hi for r, lo, hi in zip(rs, RMIN2, RMAX2))
@@ -93,13 +97,7 @@ def test_enclosures_contain_arb_values(paving6, pick, fr):
     box = np.stack([p.lo[b], p.hi[b]], -1)[None]
     pt = _point(box[0], fr)
     x, y, phi = _arb_at(pt)
-    old = ctx.prec
-    ctx.prec = 128
-    try:
-        rs = rho_sq_arb(GEOM, x, y, phi)
-        det = det_a_arb(GEOM, x, y, phi)
-    finally:
-        ctx.prec = old
+    rs, det = _arb_values(x, y, phi)
     d = det_a_tight(GEOM, box)
     assert arb(d.lo[0]) <= det and det <= arb(d.hi[0]), (d.lo[0], det, d.hi[0])
     for r, e in zip(rs, rho_sq_tight(GEOM, box)):

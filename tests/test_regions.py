@@ -11,19 +11,15 @@ from flint import arb, ctx
 
 from intervalkin import kinematics as K
 from intervalkin.dkp import solve
-from intervalkin.joint import joint_paving
 from intervalkin.paving import Label
-from intervalkin.predicates import pave_workspace
-from intervalkin.regions import analyse_regions, label_pose, uniqueness_domains
+from intervalkin.regions import label_pose, uniqueness_domains
+
+from .conftest import small_chain
 
 
 @pytest.fixture(scope="module")
 def chain(paper_geometry):
-    p = pave_workspace(paper_geometry, 7)
-    sel = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
-    jp = joint_paving(paper_geometry, p.boxes[sel], 6, max_solves=200)
-    ra = analyse_regions(paper_geometry, jp, 7)
-    return jp, ra
+    return small_chain(paper_geometry, 7, 6, 7, max_solves=200)
 
 
 def test_region_boxes_hold_their_labels_in_arb(chain, paper_geometry):

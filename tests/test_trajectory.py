@@ -13,11 +13,9 @@ from flint import arb, ctx
 from intervalkin import kinematics as K
 from intervalkin.cli import main
 from intervalkin.dkp import parse_joint_vector, solve
-from intervalkin.joint import joint_paving
-from intervalkin.paving import Label
-from intervalkin.predicates import pave_workspace
-from intervalkin.regions import analyse_regions
 from intervalkin.trajectory import NoPathError, certify_segment, trajectory
+
+from .conftest import small_chain
 
 RHO = ["14.98", "15.38", "12.0"]
 PAIRS = [(2, 3), (2, 6), (3, 6)]
@@ -28,11 +26,7 @@ PREC = 200
 @pytest.fixture(scope="module")
 def chain(paper_geometry):
     """A small but complete chain: workspace paving, joint cells, regions (depth 6)."""
-    p = pave_workspace(paper_geometry, 6)
-    sel = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
-    jp = joint_paving(paper_geometry, p.boxes[sel], 6, max_solves=200)
-    ra = analyse_regions(paper_geometry, jp, 6)
-    return jp, ra
+    return small_chain(paper_geometry, 6, 6, 6, max_solves=200)
 
 
 @pytest.fixture(scope="module")
@@ -189,10 +183,7 @@ def test_paths_pass_through_a_two_solution_cell(paths):
 
 @pytest.mark.slow
 def test_all_three_paths_meet_a_two_solution_cell_at_depth_7(paper_geometry):
-    p = pave_workspace(paper_geometry, 7)
-    sel = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
-    jp = joint_paving(paper_geometry, p.boxes[sel], 6, max_solves=200)
-    ra = analyse_regions(paper_geometry, jp, 7)
+    jp, ra = small_chain(paper_geometry, 7, 6, 7, max_solves=200)
     for pair in PAIRS:
         tr = trajectory(paper_geometry, RHO, *pair, analysis=ra, joint=jp)
         assert tr.certified and tr.through_two_solution_cell, (pair, tr.joint_cells)
