@@ -51,7 +51,6 @@ from __future__ import annotations
 import enum
 import functools
 import math
-import os
 import time
 from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
