@@ -22,8 +22,10 @@ import time
 
 
 def one(depth: int, geometry_path: str | None) -> dict:
-    from intervalkin.analysis import Stages, analyse, chain_summary
-    from intervalkin.geometry import geometry_from_option
+    from intervalkin.app.progress import Stages
+    from intervalkin.pipeline import analyse
+    from intervalkin.app.summary import chain_summary
+    from intervalkin.app.options import geometry_from_option
 
     g = geometry_from_option(geometry_path)
     st = Stages(quiet=True)

@@ -2,7 +2,7 @@
 
 Draws ~200 seeded random joint vectors (4 decimals) inside the joint limits of the
 paper's manipulator (or of --geometry FILE), solves each with
-:func:`intervalkin.dkp.solve` and prints the median and percentiles of the wall
+:func:`intervalkin.solve.dkp.solve` and prints the median and percentiles of the wall
 time, the solution counts, how many solves were proved complete, the precision
 used and the widest enclosure.
 
@@ -18,8 +18,8 @@ from fractions import Fraction
 
 import numpy as np
 
-from intervalkin.dkp import solve
-from intervalkin.geometry import geometry_from_option
+from intervalkin.solve.dkp import solve
+from intervalkin.app.options import geometry_from_option
 
 
 def main() -> None:

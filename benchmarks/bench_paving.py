@@ -24,10 +24,12 @@ import tracemalloc
 
 import numpy as np
 
-from intervalkin.geometry import default_geometry
-from intervalkin.kinematics import approx_det_a, approx_inverse_kinematics
-from intervalkin.paving import Label, shares_face
-from intervalkin.predicates import aspect_components, pave_workspace
+from intervalkin.core.geometry import default_geometry
+from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
+from intervalkin.paving.labels import Label
+from intervalkin.paving.adjacency import shares_face
+from intervalkin.space.aspect import aspect_components
+from intervalkin.paving.predicates import pave_workspace
 
 CODAC_SCRIPT = r'''
 import sys, time, json, math

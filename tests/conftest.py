@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from intervalkin.geometry import default_geometry
+from intervalkin.core.geometry import default_geometry
 
 DATA = Path(__file__).parent / "data"
 
@@ -24,8 +24,8 @@ def rng():
 
 def workspace_singular_boxes(geometry, depth: int) -> np.ndarray:
     """Leaves of a workspace paving that may hold a singular point of W (det undecided, not outside W)."""
-    from intervalkin.paving import Label
-    from intervalkin.predicates import pave_workspace
+    from intervalkin.paving.labels import Label
+    from intervalkin.paving.predicates import pave_workspace
 
     p = pave_workspace(geometry, depth)
     sel = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
@@ -35,8 +35,8 @@ def workspace_singular_boxes(geometry, depth: int) -> np.ndarray:
 def small_chain(geometry, workspace_depth: int, joint_depth: int, regions_depth: int | None = None,
                 max_solves: int = 400):
     """A small real chain for tests: joint cells from a workspace paving, and (optionally) the regions."""
-    from intervalkin.joint import joint_paving
-    from intervalkin.regions import analyse_regions
+    from intervalkin.space.joint_space import joint_paving
+    from intervalkin.space.basic_region import analyse_regions
 
     jp = joint_paving(geometry, workspace_singular_boxes(geometry, workspace_depth), joint_depth,
                       max_solves=max_solves)

@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 
-from intervalkin.cli import main
+from intervalkin.app.cli import main
 
 
 @pytest.fixture(scope="module")
@@ -86,7 +86,7 @@ def test_interrupted_run_leaves_no_partial_file(tmp_path):
     """SIGTERM in the middle of a run: every file present is complete, no temporary file is left."""
     out = tmp_path / "run"
     env = dict(os.environ)
-    proc = subprocess.Popen([sys.executable, "-m", "intervalkin.cli", "analyze", "--depth", "6", "--out", str(out),
+    proc = subprocess.Popen([sys.executable, "-m", "intervalkin", "analyze", "--depth", "6", "--out", str(out),
                              "--quiet"], env=env, stderr=subprocess.PIPE, stdout=subprocess.PIPE)
     # wait until the run has started writing, then stop it
     deadline = time.time() + 120
@@ -126,8 +126,8 @@ def test_joint_command(tmp_path, capsys):
 
 
 def test_refinement_deepens_until_consistent_or_limit(tmp_path):
-    from intervalkin.analysis import analyse
-    from intervalkin.geometry import default_geometry
+    from intervalkin.pipeline import analyse
+    from intervalkin.core.geometry import default_geometry
 
     a = analyse(default_geometry(), 5, refine_to=6)
     h = list(a.refinement)

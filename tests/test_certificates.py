@@ -14,11 +14,19 @@ import pytest
 from flint import ctx
 
 from intervalkin import checker
-from intervalkin.certificates import write_certificates
-from intervalkin.cli import main
-from intervalkin.dkp import _poly_t, _reduce, approx_solve, parse_joint_vector, solve
-from intervalkin.geometry import load_geometry
-from intervalkin.trajectory import trajectory
+from intervalkin.checker.model import _Model
+from intervalkin.checker.parse import _Refused
+from intervalkin.checker.parse import _q
+from intervalkin.checker.solutions import _count_solutions
+from intervalkin.checker.solutions import _disjoint_mod_2pi
+from intervalkin.checker.solutions import _reduced_sextic
+from intervalkin.certify.writer import write_certificates
+from intervalkin.app.cli import main
+from intervalkin.kinematics.sextic import _poly_t, _reduce
+from .approx import approx_solve
+from intervalkin.solve.dkp import parse_joint_vector, solve
+from intervalkin.core.geometry import load_geometry
+from intervalkin.space.trajectory import trajectory
 
 from .conftest import DATA, small_chain
 
@@ -158,8 +166,8 @@ def test_reduced_sextic_agrees_with_the_solver_derivation(paper_geometry, rng):
         rho = [Fraction(int(rng.integers(1000, 3200)), 100) for _ in range(3)]
         for phi0 in (0.0, round(math.pi / 6, 6)):
             with ctx.workprec(128):
-                rs = [checker._q(r * r) for r in rho]
-                mine = checker._reduced_sextic(checker._Model(paper_geometry), rs, phi0)
+                rs = [_q(r * r) for r in rho]
+                mine = _reduced_sextic(_Model(paper_geometry), rs, phi0)
                 theirs = _poly_t(_reduce(paper_geometry, rs), phi0)
             assert all(a.overlaps(b) for a, b in zip(mine, theirs))
 
@@ -170,10 +178,10 @@ def test_checker_root_count_agrees_with_float_solver(paper_geometry, rng):
     while done < 12:
         rho = [Fraction(int(rng.integers(1000, 3200)), 100) for _ in range(3)]
         with ctx.workprec(128):
-            rs = [checker._q(r * r) for r in rho]
+            rs = [_q(r * r) for r in rho]
             try:
-                n = checker._count_solutions(checker._Model(paper_geometry), rs, 0.0, 512)
-            except checker._Refused:
+                n = _count_solutions(_Model(paper_geometry), rs, 0.0, 512)
+            except _Refused:
                 continue
         assert n == len(approx_solve(paper_geometry, [float(r) for r in rho]))
         done += 1
@@ -184,7 +192,7 @@ def test_checker_det_formula_is_the_jacobian_determinant(paper_geometry, rng):
     from flint import arb, arb_mat
 
     with ctx.workprec(128):
-        model = checker._Model(paper_geometry)
+        model = _Model(paper_geometry)
         for _ in range(50):
             x, y, phi = (arb(float(v)) for v in rng.uniform([-30, -30, -math.pi], [30, 30, math.pi]))
             assert model.det(x, y, phi).overlaps(arb_mat(model.jacobian(x, y, phi)).det())
@@ -194,9 +202,9 @@ def test_disjointness_reads_phi_modulo_two_pi():
     a = ((0.0, 1.0), (0.0, 1.0), (3.1, 3.14))
     b = ((0.5, 1.5), (0.5, 1.5), (-3.18, -3.15))  # 3.1 .. 3.14 and 3.103 .. 3.133 overlap mod 2 pi
     c = ((0.5, 1.5), (0.5, 1.5), (-3.0, -2.9))
-    assert not checker._disjoint_mod_2pi(a, b)
-    assert checker._disjoint_mod_2pi(a, c)
-    assert checker._disjoint_mod_2pi(a, ((1.5, 2.0), (0.0, 1.0), (3.1, 3.14)))
+    assert not _disjoint_mod_2pi(a, b)
+    assert _disjoint_mod_2pi(a, c)
+    assert _disjoint_mod_2pi(a, ((1.5, 2.0), (0.0, 1.0), (3.1, 3.14)))
 
 
 def test_box_label_refused_when_false(paper_geometry, cert_dir):
@@ -382,7 +390,7 @@ def test_malformed_folders(cert_dir, tmp_path, capsys):
 
 
 def test_bad_sample_size_refused(tmp_path, paper_geometry):
-    from intervalkin.errors import InputError
+    from intervalkin.core.errors import InputError
 
     with pytest.raises(InputError, match="box_sample"):
         write_certificates(tmp_path, paper_geometry, box_sample=-1)

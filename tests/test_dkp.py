@@ -6,7 +6,7 @@ Independent checks used here:
   exact geometry (Fractions and surds), Newton from the box midpoint; the
   converged point must lie in the certified box with residual < 1e-40, and the
   sign of det A there must equal the certified sign.
-* :func:`intervalkin.dkp.approx_solve`: float64 dense phi sampling (no arb, no
+* :func:`intervalkin.solve.dkp.approx_solve`: float64 dense phi sampling (no arb, no
   polynomial), whose count must agree with the certified count.
 """
 
@@ -24,11 +24,13 @@ import pytest
 from hypothesis import given, settings, HealthCheck
 from hypothesis import strategies as st
 
-from intervalkin.cli import main
-from intervalkin.dkp import MAX_WIDTH, DkpResult, approx_solve, format_dkp_table, parse_joint_vector, solve
-from intervalkin.errors import InputError
-from intervalkin.geometry import Geometry, load_geometry, parse_geometry
-from intervalkin.kinematics import approx_det_a, approx_inverse_kinematics
+from intervalkin.app.cli import main
+from intervalkin.solve.dkp import MAX_WIDTH, DkpResult, parse_joint_vector, solve
+from .approx import approx_solve
+from intervalkin.app.text import format_dkp_table
+from intervalkin.core.errors import InputError
+from intervalkin.core.geometry import Geometry, load_geometry, parse_geometry
+from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
 
 from .conftest import DATA
 
@@ -321,7 +323,7 @@ def test_solution_near_phi_pi_in_paper_geometry(paper_geometry):
     old = ctx.prec
     ctx.prec = 200
     try:
-        from intervalkin.kinematics import inverse_kinematics_arb
+        from intervalkin.kinematics.formulas import inverse_kinematics_arb
 
         rho = inverse_kinematics_arb(paper_geometry, arb(X[0]), arb(X[1]), arb.pi())
         rho = [Fraction(r.str(40, radius=False)) for r in rho]
@@ -340,7 +342,7 @@ def test_solution_near_phi_pi_in_paper_geometry(paper_geometry):
 
 def _d_roots(g: Geometry) -> list[float]:
     """Angles where the 2x2 system m_i . z = k_i (i = 2, 3) is singular (float)."""
-    from intervalkin.kinematics import constants
+    from intervalkin.kinematics.constants import constants
 
     k = constants(g)
 
@@ -470,7 +472,7 @@ def test_cli_dkp_bad_geometry(capsys, tmp_path):
 
 
 def test_box_separation_reads_phi_modulo_two_pi():
-    from intervalkin.dkp import _disjoint
+    from intervalkin.solve.krawczyk import _disjoint
 
     def box(x, y, phi, r=1e-12):
         return np.array([[x - r, x + r], [y - r, y + r], [phi - r, phi + r]])

@@ -9,19 +9,12 @@ import re
 import numpy as np
 import pytest
 
-from intervalkin.export import (
-    NPZ_COLUMNS,
-    paving_columns,
-    read_npz,
-    read_vtu,
-    write_json,
-    write_npz,
-    write_vtk_legacy,
-    write_vtu,
-)
-from intervalkin.geometry import default_geometry
-from intervalkin.paving import Label
-from intervalkin.predicates import aspect_components, pave_workspace
+from intervalkin.app.export import NPZ_COLUMNS, paving_columns, read_npz, read_vtu, write_npz, write_vtk_legacy, write_vtu
+from intervalkin.core.files import write_json
+from intervalkin.core.geometry import default_geometry
+from intervalkin.paving.labels import Label
+from intervalkin.space.aspect import aspect_components
+from intervalkin.paving.predicates import pave_workspace
 
 
 @pytest.fixture(scope="module")
@@ -106,7 +99,7 @@ def test_json_atomic(tmp_path):
 
 def test_vtu_with_shared_points(tmp_path):
     """Shared corners: fewer points than 8 per box, every cell's corners are its box's corners."""
-    from intervalkin.export import write_vtu_paving
+    from intervalkin.app.export import write_vtu_paving
 
     g = default_geometry()
     p = pave_workspace(g, 4)

@@ -7,9 +7,9 @@ from fractions import Fraction
 import pytest
 from flint import arb, ctx
 
-from intervalkin.cli import main
-from intervalkin.errors import GeometryError
-from intervalkin.geometry import default_geometry, load_geometry
+from intervalkin.app.cli import main
+from intervalkin.core.errors import GeometryError
+from intervalkin.core.geometry import default_geometry, load_geometry
 
 from .conftest import DATA
 

@@ -14,15 +14,8 @@ from flint import arb, ctx
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from intervalkin.interval import (
-    PI_HI,
-    PI_LO,
-    TRIG_ABS_ERROR,
-    Interval,
-    arb_to_bounds,
-    fraction_bounds,
-    sign_label,
-)
+from intervalkin.core.interval import PI_HI, PI_LO, TRIG_ABS_ERROR, Interval, sign_label
+from intervalkin.core.exact import arb_to_bounds, fraction_bounds
 
 finite = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False, allow_infinity=False)
 unit = st.floats(min_value=0.0, max_value=1.0)

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from flint import arb, ctx
 
-from intervalkin import kinematics as K
-from intervalkin.dkp import solve
-from intervalkin.joint import _mark, _range_sum, _summed_area, joint_paving, solution_count
+from intervalkin.kinematics.formulas import approx_det_a, det_a_arb, inverse_kinematics_arb
+from intervalkin.solve.dkp import solve
+from intervalkin.space.joint_space import _mark, _range_sum, _summed_area, joint_paving, solution_count
 
 from .conftest import small_chain
 
@@ -64,18 +64,18 @@ def _certified_singular_point(g, rng):
     while True:
         x, phi = float(rng.uniform(-32, 32)), float(rng.uniform(-np.pi, np.pi))
         ys = np.linspace(-32, 32, 257)
-        d = K.approx_det_a(g, np.column_stack([np.full_like(ys, x), ys, np.full_like(ys, phi)]))
+        d = approx_det_a(g, np.column_stack([np.full_like(ys, x), ys, np.full_like(ys, phi)]))
         idx = np.flatnonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0)
         if idx.size == 0:
             continue
         a, b = ys[idx[0]], ys[idx[0] + 1]
-        da = K.det_a_arb(g, arb(x), arb(a), arb(phi))
-        db = K.det_a_arb(g, arb(x), arb(b), arb(phi))
+        da = det_a_arb(g, arb(x), arb(a), arb(phi))
+        db = det_a_arb(g, arb(x), arb(b), arb(phi))
         if not ((da < 0 and db > 0) or (da > 0 and db < 0)):
             continue
         for _ in range(40):  # bisection, every sign decided in arb
             m = 0.5 * (a + b)
-            dm = K.det_a_arb(g, arb(x), arb(m), arb(phi))
+            dm = det_a_arb(g, arb(x), arb(m), arb(phi))
             if dm == 0 or not (dm < 0 or dm > 0):
                 break
             if (dm < 0) == (da < 0):
@@ -95,7 +95,7 @@ def test_enclosure_of_gS_covers_certified_singular_points(joint, paper_geometry)
         for _ in range(400):
             x, (a, b), phi = _certified_singular_point(paper_geometry, rng)
             y = arb(a).union(arb(b))
-            rho = K.inverse_kinematics_arb(paper_geometry, arb(x), y, arb(phi))
+            rho = inverse_kinematics_arb(paper_geometry, arb(x), y, arb(phi))
             lo = np.array([[float(r.lower()) for r in rho]])
             hi = np.array([[float(r.upper()) for r in rho]])
             lim = (10.0 + 1e-6, 32.0 - 1e-6)
@@ -133,7 +133,7 @@ def test_marking_and_range_sums_match_brute_force():
 
 
 def test_bad_depth_is_refused(paper_geometry):
-    from intervalkin.errors import InputError
+    from intervalkin.core.errors import InputError
 
     with pytest.raises(InputError, match="joint depth"):
         joint_paving(paper_geometry, np.zeros((0, 3, 2)), 12)

@@ -8,9 +8,9 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from intervalkin.cli import main
-from intervalkin.dkp import MAX_WIDTH
-from intervalkin.paper import TABLE1_ROWS, TABLE1_SAME_ASPECT, format_table1, table1_comparison
+from intervalkin.app.cli import main
+from intervalkin.solve.dkp import MAX_WIDTH
+from intervalkin.app.table1 import TABLE1_ROWS, TABLE1_SAME_ASPECT, format_table1, table1_comparison
 
 from .test_dkp import check_certified
 

@@ -6,23 +6,13 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from intervalkin.errors import InputError, ResourceError
-from intervalkin.geometry import default_geometry
-from intervalkin.paving import (
-    Label,
-    and_labels,
-    box_bounds,
-    check_depth,
-    component_labels,
-    connected_components,
-    estimate_memory_bytes,
-    not_label,
-    pave,
-    pave_multi,
-    shares_face,
-    shares_face_bruteforce,
-)
-from intervalkin.predicates import pave_workspace, workspace_predicate
+from intervalkin.core.errors import InputError, ResourceError
+from intervalkin.core.geometry import default_geometry
+from intervalkin.paving.labels import Label, and_labels, not_label
+from intervalkin.paving.tree import box_bounds, pave, pave_multi
+from intervalkin.paving.budget import check_depth, estimate_memory_bytes
+from intervalkin.paving.adjacency import component_labels, connected_components, shares_face, shares_face_bruteforce
+from intervalkin.paving.predicates import pave_workspace, workspace_predicate
 
 GEOM = default_geometry()
 
@@ -212,11 +202,11 @@ def test_depth_validation():
 
 
 def test_depth_refused_when_memory_short(monkeypatch):
-    import intervalkin.paving as pv
+    from intervalkin.paving import budget
 
-    monkeypatch.setattr(pv, "available_memory_bytes", lambda: 1e8)
+    monkeypatch.setattr(budget, "available_memory_bytes", lambda: 1e8)
     with pytest.raises(ResourceError, match="exceeds available"):
-        pv.check_depth(6)
+        budget.check_depth(6)
 
 
 def test_bad_domain():
@@ -226,7 +216,7 @@ def test_bad_domain():
 
 def test_locate_boxes_matches_brute_force(paper_geometry):
     """The key lookup finds exactly the leaf that contains a small query box, or -1."""
-    from intervalkin.predicates import pave_workspace
+    from intervalkin.paving.predicates import pave_workspace
 
     p = pave_workspace(paper_geometry, 5)
     rng = np.random.default_rng(3)

@@ -12,19 +12,14 @@ import pytest
 from flint import arb, ctx, fmpq
 from hypothesis import given, settings, strategies as st
 
-from intervalkin.geometry import default_geometry
-from intervalkin.kinematics import det_a_arb, det_a_interval, rho_sq_arb
-from intervalkin.paving import Label, shares_face
-from intervalkin.predicates import (
-    aspect_components,
-    aspect_labels,
-    aspect_predicate,
-    det_a_tight,
-    det_sign_labels,
-    pave_workspace,
-    rho_sq_tight,
-    workspace_labels,
-)
+from intervalkin.core.geometry import default_geometry
+from intervalkin.kinematics.formulas import det_a_arb, rho_sq_arb
+from intervalkin.kinematics.enclosures import det_a_interval
+from intervalkin.paving.labels import Label
+from intervalkin.paving.adjacency import shares_face
+from intervalkin.space.aspect import aspect_components
+from intervalkin.paving.predicates import aspect_labels, aspect_predicate, det_sign_labels, pave_workspace, workspace_labels
+from intervalkin.kinematics.quadratic import det_a_tight, rho_sq_tight
 
 GEOM = default_geometry()
 RMIN2 = [arb(fmpq(v.numerator, v.denominator)) ** 2 for v in GEOM.rho_min]

@@ -9,10 +9,12 @@ import numpy as np
 import pytest
 from flint import arb, ctx
 
-from intervalkin import kinematics as K
-from intervalkin.dkp import solve
-from intervalkin.paving import Label
-from intervalkin.regions import label_pose, uniqueness_domains
+from intervalkin.kinematics.formulas import det_a_arb, inverse_kinematics_arb
+from intervalkin.solve.continuation import _newton, compare_mod_2pi, krawczyk_segment, new_tracks, track
+from intervalkin.solve.dkp import solve
+from intervalkin.paving.labels import Label
+from intervalkin.space.basic_region import label_pose
+from intervalkin.space.uniqueness_domain import uniqueness_domains
 
 from .conftest import small_chain
 
@@ -37,9 +39,9 @@ def test_region_boxes_hold_their_labels_in_arb(chain, paper_geometry):
             t = rng.uniform(0, 1, 3)
             X = p.lo[i] + t * (p.hi[i] - p.lo[i])
             x, y, phi = (arb(float(v)) for v in X)
-            d = K.det_a_arb(paper_geometry, x, y, phi)
+            d = det_a_arb(paper_geometry, x, y, phi)
             assert (d > 0) if r.aspect == "WA1" else (d < 0)
-            rho = K.inverse_kinematics_arb(paper_geometry, x, y, phi)
+            rho = inverse_kinematics_arb(paper_geometry, x, y, phi)
             assert all(v > 10 and v < 32 for v in rho)
             lo = np.array([[float(v.lower()) for v in rho]])
             hi = np.array([[float(v.upper()) for v in rho]])
@@ -140,7 +142,7 @@ def test_uniqueness_domains_respect_theorem_2(chain):
 
 def test_uniqueness_domains_on_a_small_graph():
     """Hand-made: two cells with 2 regions each per aspect, a path graph: 2 groups are enough."""
-    from intervalkin.regions import BasicRegion
+    from intervalkin.space.basic_region import BasicRegion
 
     regs = [BasicRegion(i, "WA1", c, s, 4, 1, 1.0, 1) for i, (c, s) in enumerate([(0, 0), (0, 1), (1, 0), (1, 1)])]
     groups, bound = uniqueness_domains(regs, {(0, 2), (1, 3)})
@@ -222,7 +224,7 @@ def _fold_segment(geometry):
 
     Along q_s + s dq the two solutions near X_s exist for s < 0 and merge at s = 0.
     """
-    from intervalkin.kinematics import approx_det_a, approx_inverse_kinematics, approx_jacobian
+    from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics, approx_jacobian
 
     xs = np.linspace(-30, 30, 6001)
     P = np.stack([xs, np.full_like(xs, -10.0), np.full_like(xs, 0.3)], axis=1)
@@ -249,13 +251,12 @@ def _fold_segment(geometry):
 
 def test_parameter_krawczyk_refuses_steps_across_a_fold(paper_geometry):
     """Krawczyk over [t0, t1] holding the fold is refused; tracking stops before it, never past it."""
-    from intervalkin import continuation as C
-    from intervalkin.interval import Interval
+    from intervalkin.core.interval import Interval
 
     x_s, q_s, dq = _fold_segment(paper_geometry)
     side = None
     for s in (-1.0, 1.0):
-        p, conv = C._newton(paper_geometry, x_s[None] + 0.05, (q_s + s * dq)[None], iters=40)
+        p, conv = _newton(paper_geometry, x_s[None] + 0.05, (q_s + s * dq)[None], iters=40)
         if conv[0] and np.max(np.abs(p[0] - x_s)) < 2.0:
             side, start = s, p[0]
     assert side is not None
@@ -264,23 +265,22 @@ def test_parameter_krawczyk_refuses_steps_across_a_fold(paper_geometry):
     # any box around the singular pose, over a parameter range holding t = 1/2: refused
     for r in (1e-3, 1e-2, 0.1, 1.0):
         lo, hi = x_s[None] - r, x_s[None] + r
-        ok, _, _ = C.krawczyk_segment(paper_geometry, lo, hi, qa, qb, np.array([0.4]), np.array([0.6]))
+        ok, _, _ = krawczyk_segment(paper_geometry, lo, hi, qa, qb, np.array([0.4]), np.array([0.6]))
         assert not ok[0]
     # from the side with solutions, across the fold: the track must give up
     z = np.stack([start - 1e-9, start + 1e-9])
-    tr = C.track(paper_geometry, C.new_tracks(qa, qb, start[None], z[0][None], z[1][None]))
+    tr = track(paper_geometry, new_tracks(qa, qb, start[None], z[0][None], z[1][None]))
     assert tr.status[0] == -1 and tr.t[0] < 0.5
     # the same solution tracked to just before the fold: certified, and it ends near the fold
     near = Interval.point((q_s + side * 0.1 * dq)[None])
-    tr = C.track(paper_geometry, C.new_tracks(qa, near, start[None], z[0][None], z[1][None]))
+    tr = track(paper_geometry, new_tracks(qa, near, start[None], z[0][None], z[1][None]))
     assert tr.status[0] == 1
     assert np.all(tr.x_lo[0] <= tr.p[0]) and np.all(tr.p[0] <= tr.x_hi[0])
 
 
 def test_tracked_box_holds_the_certified_solution_at_the_end(paper_geometry):
     """Tracks between two exact joint vectors end in boxes holding exactly the solver's solutions there."""
-    from intervalkin import continuation as C
-    from intervalkin.interval import Interval
+    from intervalkin.core.interval import Interval
 
     qa = (Fraction(15), Fraction(20), Fraction(18))
     qb = (Fraction(31, 2), Fraction(39, 2), Fraction(18))
@@ -290,12 +290,12 @@ def test_tracked_box_holds_the_certified_solution_at_the_end(paper_geometry):
     A = Interval.point(np.tile([float(v) for v in qa], (m, 1)))
     B = Interval.point(np.tile([float(v) for v in qb], (m, 1)))
     boxes = np.array([np.asarray(s.box) for s in ra.solutions])
-    tr = C.track(paper_geometry, C.new_tracks(A, B, boxes.mean(axis=2), boxes[:, :, 0], boxes[:, :, 1]))
+    tr = track(paper_geometry, new_tracks(A, B, boxes.mean(axis=2), boxes[:, :, 0], boxes[:, :, 1]))
     assert np.all(tr.status == 1)
     ends = np.array([np.asarray(s.box) for s in rb.solutions])
     seen = []
     for i in range(m):
-        inside, apart = C.compare_mod_2pi(np.repeat(tr.x_lo[i:i + 1], m, 0), np.repeat(tr.x_hi[i:i + 1], m, 0),
+        inside, apart = compare_mod_2pi(np.repeat(tr.x_lo[i:i + 1], m, 0), np.repeat(tr.x_hi[i:i + 1], m, 0),
                                           ends[:, :, 0], ends[:, :, 1])
         assert inside.sum() == 1 and apart.sum() == m - 1  # each track ends on exactly one solution
         j = int(np.flatnonzero(inside)[0])

@@ -10,10 +10,11 @@ import numpy as np
 import pytest
 from flint import arb, ctx
 
-from intervalkin import kinematics as K
-from intervalkin.cli import main
-from intervalkin.dkp import parse_joint_vector, solve
-from intervalkin.trajectory import NoPathError, certify_segment, trajectory
+from intervalkin.kinematics.formulas import approx_inverse_kinematics, det_a_arb, inverse_kinematics_arb
+from intervalkin.app.cli import main
+from intervalkin.solve.dkp import parse_joint_vector, solve
+from intervalkin.space.trajectory import NoPathError, trajectory
+from intervalkin.space.segment import certify_segment
 
 from .conftest import small_chain
 
@@ -56,10 +57,10 @@ def _point_on_segment(seg, t: Fraction):
 
 
 def _ok_in_arb(geometry, x, y, phi, sign: int) -> bool:
-    d = K.det_a_arb(geometry, x, y, phi)
+    d = det_a_arb(geometry, x, y, phi)
     if not ((d > 0) if sign > 0 else (d < 0)):
         return False
-    return all(r >= 10 and r <= 32 for r in K.inverse_kinematics_arb(geometry, x, y, phi))
+    return all(r >= 10 and r <= 32 for r in inverse_kinematics_arb(geometry, x, y, phi))
 
 
 # --------------------------------------------------------------------------------------
@@ -144,7 +145,7 @@ def test_a_path_crosses_the_phi_seam(paths):
 
 def test_joint_image_pieces_map_into_their_cells(paths, chain, paper_geometry):
     """The cells reported along the path hold the arb images of points of their pieces."""
-    from intervalkin.trajectory import _cells_along
+    from intervalkin.space.trajectory import _cells_along
 
     jp, _ = chain
     rng = np.random.default_rng(3)
@@ -158,7 +159,7 @@ def test_joint_image_pieces_map_into_their_cells(paths, chain, paper_geometry):
                 for k in np.flatnonzero(cells >= 0)[:40]:
                     t = Fraction(float(t0[k] + rng.uniform() * (ends[k] - t0[k])))
                     x, y, phi = _point_on_segment(seg, t)
-                    rho = K.inverse_kinematics_arb(paper_geometry, x, y, phi)
+                    rho = inverse_kinematics_arb(paper_geometry, x, y, phi)
                     lo = np.array([[float(r.lower()) for r in rho]])
                     hi = np.array([[float(r.upper()) for r in rho]])
                     ilo, ihi, _ = jp.index_ranges(lo, hi)
@@ -199,7 +200,7 @@ def test_different_aspects_have_no_path(paper_geometry, capsys):
 
 
 def test_bad_requests_are_input_errors(paper_geometry):
-    from intervalkin.errors import InputError
+    from intervalkin.core.errors import InputError
 
     with pytest.raises(InputError, match="--to"):
         trajectory(paper_geometry, RHO, 2, 7, depth=4)
@@ -215,13 +216,13 @@ def test_certifier_refuses_a_straight_segment_through_the_singularity(paper_geom
     old = ctx.prec
     ctx.prec = PREC
     try:
-        from intervalkin.trajectory import SegmentCertificate
+        from intervalkin.space.segment import SegmentCertificate
 
         seg = SegmentCertificate(a, b, 1, np.zeros((0, 2)), False)
         negative = []
         for k in range(1, 200):
             x, y, phi = _point_on_segment(seg, Fraction(k, 200))
-            if K.det_a_arb(paper_geometry, x, y, phi) < 0:
+            if det_a_arb(paper_geometry, x, y, phi) < 0:
                 negative.append(k)
         assert negative, "the straight segment 2 -> 3 should cross det A = 0"
     finally:
@@ -236,12 +237,12 @@ def test_certifier_refuses_a_segment_leaving_the_joint_limits(paper_geometry, so
     a, b = np.asarray(solutions[2].box), np.asarray(solutions[5].box)
     t = np.linspace(0, 1, 401)[:, None]
     pts = 0.5 * (a[:, 0] + a[:, 1]) + t * (0.5 * (b[:, 0] + b[:, 1]) - 0.5 * (a[:, 0] + a[:, 1]))
-    k = int(np.argmin(K.approx_inverse_kinematics(paper_geometry, pts).min(axis=1)))
+    k = int(np.argmin(approx_inverse_kinematics(paper_geometry, pts).min(axis=1)))
     old = ctx.prec
     ctx.prec = PREC
     try:
         x, y, phi = (arb(float(v)) for v in pts[k])
-        assert any(r < 10 for r in K.inverse_kinematics_arb(paper_geometry, x, y, phi))
+        assert any(r < 10 for r in inverse_kinematics_arb(paper_geometry, x, y, phi))
     finally:
         ctx.prec = old
     cert = certify_segment(paper_geometry, a, b, +1)
@@ -256,7 +257,7 @@ def test_certify_segment_inside_one_box(paper_geometry):
 
 
 def test_json_object_and_outputs(paths, paper_geometry, chain, tmp_path):
-    from intervalkin.trajectory import write_trajectory
+    from intervalkin.app.animation import write_trajectory
 
     jp, ra = chain
     tr = paths[(2, 3)]

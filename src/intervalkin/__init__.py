@@ -1,43 +1,53 @@
 """intervalkin: certified definition sets of the planar 3-RPR parallel manipulator.
 
-The package follows Wenger & Chablat (1997), one module per concept, data flowing
-one way (each module imports only modules above it in this list):
+Layers, from the ground floor up (a layer imports only the layers below it; the
+import-linter contract in ``pyproject.toml`` enforces it):
 
-geometry      the manipulator as exact, validated data (the paper's is the default)
-interval      vectorized outward-rounded interval arithmetic; the bridge to arb
-kinematics    g, A and det A: float (approx_*), interval (natural and centred forms), arb
-paving        octree pavings: tri-state labels, subdivision, face adjacency with the phi seam
-checker       the independent verifier of certificates (geometry + arb only)
-dkp           certified direct kinematics: every solution, proved unique, completeness proved
-predicates    W, the sign of det A and the aspects as tri-state labels over arrays of boxes
-export        atomic npz / JSON / VTK writers          figures   PNG renderings
-joint         joint space: outer enclosure of g(S), cells of certified solution count
-continuation  certified tracking of solutions along joint-space paths (sheets of a cell)
-regions       characteristic surfaces, basic regions, basic components, uniqueness domains
-certificates  claim files written from the results above
-trajectory    certified non-singular assembly-mode changing paths
-analysis      the whole chain for one geometry, writing one output folder
-paper         the paper's Table 1, counts and report, regenerated and compared
-cli           the ``intervalkin`` command
+core/        the manipulator as exact data, interval arithmetic (the one rounding layer), errors, files
+kinematics/  g, A, det A and the sextic: written once, evaluated in float, intervals and arb
+paving/      octree box trees, tri-state labels, adjacency with the phi seam, memory budget, predicates
+solve/       certified direct kinematics; continuation of solutions along joint-space paths
+space/       aspects, joint space, characteristic surfaces, basic regions, uniqueness domains, trajectories
+checker/     the independent verifier of certificates (standard library, python-flint and core only)
+certify/     claim files written from the results above
+pipeline     the whole analysis as one library call
+app/         the ``intervalkin`` command, output folders, report, export, figures, animation
+
+The public names below are loaded on first use, so ``import intervalkin.checker``
+does not pull in numpy or the paving code.
 """
 
-from .errors import GeometryError, InputError, IntervalkinError, ResourceError
-from .geometry import Geometry, Surd, default_geometry, load_geometry
-from .interval import Interval
+from __future__ import annotations
 
-__all__ = [
-    "IntervalkinError",
-    "GeometryError",
-    "InputError",
-    "ResourceError",
-    "Geometry",
-    "Surd",
-    "default_geometry",
-    "load_geometry",
-    "Interval",
-]
+import importlib
 
-__version__ = "0.1.0"
+from intervalkin.core.version import __version__
 
-#: Default octree depth of ``intervalkin analyze`` / ``paper`` (about a minute on two cores).
-DEFAULT_DEPTH = 8
+# name -> module that defines it (loaded lazily by __getattr__)
+_API = {
+    "IntervalkinError": "intervalkin.core.errors",
+    "GeometryError": "intervalkin.core.errors",
+    "InputError": "intervalkin.core.errors",
+    "ResourceError": "intervalkin.core.errors",
+    "Geometry": "intervalkin.core.geometry",
+    "Surd": "intervalkin.core.geometry",
+    "default_geometry": "intervalkin.core.geometry",
+    "load_geometry": "intervalkin.core.geometry",
+    "Interval": "intervalkin.core.interval",
+    "DEFAULT_DEPTH": "intervalkin.pipeline",
+}
+
+__all__ = ["__version__", *_API]
+
+
+def __getattr__(name: str):
+    module = _API.get(name)
+    if module is None:
+        raise AttributeError(f"module 'intervalkin' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

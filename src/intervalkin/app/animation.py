@@ -1,0 +1,310 @@
+"""Certified non-singular trajectories between assembly modes of one aspect.
+
+The paper (section 3.2, Table 1) observes that solutions 2, 3 and 6 of the joint
+vector rho = (14.98, 15.38, 12.0) lie in one aspect WA1, so the platform can move
+from one to another without meeting a type-2 singularity; section 5.2 and
+Figure 13 add that such a motion must pass through an intermediate basic region,
+whose image is a joint-space domain with only two solutions.  This module builds
+such a motion and PROVES it non-singular.
+
+Construction
+------------
+1. The two solutions are the certified direct-kinematic boxes of
+   :func:`dkp.solve` (numbered from 1 in increasing phi, as ``intervalkin dkp``
+   prints them).  Opposite certified signs of det A put them in different
+   aspects: then no non-singular path exists and :class:`NoPathError` says so.
+2. A shortest path (A*, exact for the metric below) in the face-adjacency graph
+   of the paving boxes certified INSIDE the aspect, from the box nearest the
+   start solution to the box nearest the goal.  Edge weight: the distance of the
+   box centres in the metric ``sqrt(dx^2 + dy^2 + (L dphi)^2)``, dphi taken
+   modulo 2 pi and L the root-mean-square distance of the platform points from
+   B1 (so a rotation costs about what it moves the platform).
+3. Waypoints: the start solution, the centre of the face piece shared by each
+   pair of consecutive boxes, the goal solution.  Each straight segment between
+   them lies in one certified box.
+4. Smoothing: a waypoint is dropped when the straight segment that skips it is
+   itself certified (step 5); the farthest certifiable waypoint is searched by
+   doubling then bisection.
+
+phi convention
+--------------
+Waypoints carry an UNWRAPPED phi: phi is continuous along the path, it starts at
+the start solution's phi (in (-pi, pi]) and may leave (-pi, pi] when the path
+crosses the seam phi = +-pi.  The last waypoint is the goal solution's phi plus
+``2 pi * phi_turns``.  Take phi modulo 2 pi to get the usual pose.  The
+kinematics are 2 pi periodic in phi, so nothing else changes.
+
+Certificate (proofs/lemma-trajectory-certificate.md)
+----------------------------------------------------
+The motion is the concatenation of the exact straight segments
+P(t) = A + t (B - A), t in [0, 1], between consecutive waypoints, where the
+first A and the last B are the EXACT solutions (known through their enclosures)
+and the other waypoints are the floats stored.  For each segment, [0, 1] is cut
+into pieces [t0, t1]; the interval expression A + [t0, t1] (B - A) (outward
+rounded, A and B as intervals) is a box containing the piece of the segment,
+and on that box :func:`kinematics.det_a_interval` is proved of the aspect's sign
+and :func:`kinematics.rho_sq_interval` proved within [rho_min^2, rho_max^2] for
+every leg.  Failing pieces are bisected; past :data:`MAX_BISECTIONS` halvings
+the segment is not certified (``certified`` False, with the reason).  This test
+does not use the paving at all: the paving only proposes the path.
+
+Also reported, with what each claim rests on:
+
+* the basic regions crossed (when a :class:`~intervalkin.space.basic_region.RegionAnalysis`
+  is given): region ids of the paving leaves met by points sampled along the
+  path at steps below half the finest leaf width, consecutive repeats merged,
+  -1 ("layer") where the leaf carries no region (the enclosure of S_c or an
+  undecided sheet).  Sampled, so a region touched only between two samples
+  could be missed;
+* the joint-space image (when a :class:`~intervalkin.space.joint_space.JointPaving` is
+  given): each piece of each segment is enclosed in a box, its interval image
+  g(box) computed, and :meth:`JointPaving.cell_of_boxes` names the cell that
+  contains it: a certified statement "this piece maps into cell c", whose count
+  is certified.  Pieces whose image may meet g(S) are reported as "layer".
+  Unlike ``cell_at`` on rounded joint vectors, this covers every point of the path.
+
+In both sequences a layer stretch between two visits of the same region (or
+cell) is merged into it: the path left the certified part and came back, and
+what it met meanwhile is not resolved at this depth.  The raw per-sample region
+ids are kept in ``Trajectory.sample_region``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from intervalkin.core.files import atomic_write_bytes, write_json
+from intervalkin.core.geometry import Geometry
+from intervalkin.paving.labels import Label
+from intervalkin.paving.tree import Paving
+from intervalkin.space.joint_space import JointPaving
+from intervalkin.space.path_search import _dist, _metric_length, _wrap
+from intervalkin.space.trajectory import Trajectory
+
+__all__ = ['render_trajectory', 'write_trajectory']
+
+
+# --------------------------------------------------------------------------------------
+# Output: JSON and figures (atomic)
+# --------------------------------------------------------------------------------------
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save_png(fig, path: Path) -> Path:
+    import io
+
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    return atomic_write_bytes(path, buf.getvalue())
+
+
+def _platform(geometry: Geometry, pose: np.ndarray):
+    """Base points (3, 2) and platform points (3, 2) of a float pose (for drawing)."""
+    base = np.array([[float(c) for c in a] for a in geometry.base])
+    x, y, phi = pose
+    c, s = math.cos(phi), math.sin(phi)
+    pts = []
+    for i in range(3):
+        px, py = (float(v) for v in geometry.platform_point(i))
+        pts.append((x + c * px - s * py, y + s * px + c * py))
+    return base, np.array(pts)
+
+
+def _segments_3d(samples: np.ndarray):
+    """Split a path at the phi seam: list of (k, 3) arrays with wrapped phi."""
+    w = samples.copy()
+    w[:, 2] = _wrap(w[:, 2])
+    jumps = np.flatnonzero(np.abs(np.diff(w[:, 2])) > math.pi) + 1
+    return np.split(w, jumps)
+
+
+def render_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, paving: Paving | None = None,
+                      joint: "JointPaving | None" = None, frames: int = 48) -> list[Path]:
+    """Write the figures of a trajectory into folder ``out`` (atomically); returns the paths.
+
+    * ``trajectory_workspace_3d.png``: the path in (x, y, phi), phi wrapped, over
+      the singular layer of the paving (grey, subsampled) with the solutions numbered;
+    * ``trajectory_workspace_xy.png``: its projection on the (x, y) plane;
+    * ``trajectory_joint.png``: its image g(path) in joint space over the marked
+      layer of the joint paving, coloured by the certified count of the cell, and
+      the count along the path;
+    * ``trajectory_animation.gif`` (Pillow) or ``trajectory_frames/frame_NNN.png``:
+      the platform and legs moving.
+    """
+    plt = _plt()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    rng = np.random.default_rng(0)
+    sols = np.array([s.midpoint for s in traj.solutions]) if traj.solutions else np.zeros((0, 3))
+    colour = "#1f77b4" if traj.sign > 0 else "#d62728"
+    layer = None
+    if paving is not None:
+        sel = np.flatnonzero((paving.labels["W"] != Label.OUTSIDE) & (paving.labels["det_positive"] == Label.BOUNDARY))
+        if sel.size > 6000:
+            sel = np.sort(rng.choice(sel, 6000, replace=False))
+        layer = 0.5 * (paving.lo[sel] + paving.hi[sel])
+    title = (f"rho = ({', '.join(f'{float(v):g}' for v in traj.rho)}): solution {traj.i_from} -> {traj.i_to} "
+             f"in {traj.aspect}, {'certified' if traj.certified else 'NOT certified'}")
+
+    # 3-D workspace
+    fig = plt.figure(figsize=(7.5, 6.5))
+    ax = fig.add_subplot(projection="3d")
+    if layer is not None:
+        ax.scatter(layer[:, 0], layer[:, 1], layer[:, 2], s=2, c="0.6", alpha=0.3, label="det A = 0 (undecided layer)")
+    for k, part in enumerate(_segments_3d(traj.samples)):
+        ax.plot(part[:, 0], part[:, 1], part[:, 2], color=colour, lw=2.5, label="path" if k == 0 else None)
+    for i, s in enumerate(sols, 1):
+        ax.scatter([s[0]], [s[1]], [s[2]], color="k", s=18)
+        ax.text(s[0], s[1], s[2], f" {i}", fontsize=9)
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_zlabel("phi (rad)")
+    ax.set_title(title, fontsize=9)
+    ax.legend(loc="upper left", fontsize=8)
+    written.append(_save_png(fig, out / "trajectory_workspace_3d.png"))
+    plt.close(fig)
+
+    # x-y projection
+    fig, ax = plt.subplots(figsize=(7, 6.5))
+    if layer is not None:
+        ax.scatter(layer[:, 0], layer[:, 1], s=1, c="0.8", alpha=0.3, label="det A = 0 (undecided layer)")
+    ax.plot(traj.samples[:, 0], traj.samples[:, 1], color=colour, lw=2, label="path")
+    ax.plot(traj.waypoints[:, 0], traj.waypoints[:, 1], "o", color=colour, ms=3, label="waypoints")
+    for i, s in enumerate(sols, 1):
+        ax.plot(s[0], s[1], "k*", ms=8)
+        ax.annotate(str(i), (s[0], s[1]), textcoords="offset points", xytext=(4, 4))
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (B1)")
+    ax.set_ylabel("y (B1)")
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=8)
+    written.append(_save_png(fig, out / "trajectory_workspace_xy.png"))
+    plt.close(fig)
+
+    # joint space
+    fig = plt.figure(figsize=(12, 5.5))
+    ax = fig.add_subplot(1, 2, 1, projection="3d")
+    if joint is not None:
+        idx = np.argwhere(joint.marked)
+        if idx.shape[0] > 8000:
+            idx = idx[rng.choice(idx.shape[0], 8000, replace=False)]
+        r0 = np.array([float(v) for v in joint.rho_min])
+        h = np.array([float(v) for v in joint.step])
+        vox = r0 + (idx + 0.5) * h
+        ax.scatter(vox[:, 0], vox[:, 1], vox[:, 2], s=2, c="0.6", alpha=0.2, label="enclosure of g(S)")
+    counts = traj.sample_count if traj.sample_count is not None else np.full(len(traj.samples), -1)
+    cmap = {-1: "0.4", 2: "#2ca02c", 4: "#ff7f0e", 6: "#9467bd", 0: "k"}
+    r = traj.sample_rho
+    for c in sorted(set(counts.tolist())):
+        m = counts == c
+        ax.scatter(r[m, 0], r[m, 1], r[m, 2], s=4, color=cmap.get(c, "c"),
+                   label=f"{c} solutions" if c >= 0 else "layer (may meet g(S))")
+    ax.scatter(*[[float(v)] for v in traj.rho], color="k", s=40, marker="*", label="rho (start = end)")
+    ax.set_xlabel("rho1")
+    ax.set_ylabel("rho2")
+    ax.set_zlabel("rho3")
+    ax.legend(fontsize=7, loc="upper left")
+    ax.set_title("image g(path): a closed loop in joint space", fontsize=9)
+    ax2 = fig.add_subplot(1, 2, 2)
+    s_along = np.concatenate([[0.0], np.cumsum(_dist(traj.samples[:-1], traj.samples[1:], _metric_length(geometry)))])
+    ax2.step(s_along, np.where(counts >= 0, counts, np.nan), where="post", color="k")
+    ax2.scatter(s_along[counts < 0], np.full(np.count_nonzero(counts < 0), 0.5), s=3, color="0.5",
+                label="image may meet g(S)")
+    ax2.set_yticks([0, 2, 4, 6])
+    ax2.set_xlabel("length along the path")
+    ax2.set_ylabel("certified number of solutions of g(X)")
+    ax2.set_title("solution count along the path (joint cells)", fontsize=9)
+    ax2.legend(fontsize=8)
+    written.append(_save_png(fig, out / "trajectory_joint.png"))
+    plt.close(fig)
+
+    written += _render_animation(traj, geometry, out, frames)
+    return written
+
+
+def _render_animation(traj: Trajectory, geometry: Geometry, out: Path, frames: int) -> list[Path]:
+    plt = _plt()
+    s = traj.samples
+    L = _metric_length(geometry)
+    arc = np.concatenate([[0.0], np.cumsum(_dist(s[:-1], s[1:], L))])
+    targets = np.linspace(0.0, arc[-1], frames)
+    poses = np.stack([np.interp(targets, arc, s[:, j]) for j in range(3)], axis=1)
+    allpts = np.vstack([_platform(geometry, p)[1] for p in poses] + [_platform(geometry, poses[0])[0]])
+    pad = 3.0
+    xl = (allpts[:, 0].min() - pad, allpts[:, 0].max() + pad)
+    yl = (allpts[:, 1].min() - pad, allpts[:, 1].max() + pad)
+
+    fig, ax = plt.subplots(figsize=(6, 6))
+
+    def draw(k):
+        ax.clear()
+        base, plat = _platform(geometry, poses[k])
+        for i in range(3):
+            ax.plot([base[i, 0], plat[i, 0]], [base[i, 1], plat[i, 1]], color="0.3", lw=2)
+        tri = np.vstack([plat, plat[:1]])
+        ax.fill(tri[:, 0], tri[:, 1], color="#1f77b4" if traj.sign > 0 else "#d62728", alpha=0.5)
+        ax.plot(tri[:, 0], tri[:, 1], color="k", lw=1)
+        ax.plot(base[:, 0], base[:, 1], "ks", ms=6)
+        ax.plot(s[:, 0], s[:, 1], color="0.7", lw=1)
+        ax.set_xlim(*xl)
+        ax.set_ylim(*yl)
+        ax.set_aspect("equal")
+        ax.set_title(f"solution {traj.i_from} -> {traj.i_to} ({traj.aspect}), frame {k + 1}/{len(poses)}", fontsize=9)
+
+    written: list[Path] = []
+    try:
+        import PIL  # noqa: F401
+
+        have_pillow = True
+    except ImportError:  # pragma: no cover - Pillow ships with matplotlib in practice
+        have_pillow = False
+    if have_pillow:
+        from matplotlib.animation import FuncAnimation, PillowWriter
+
+        anim = FuncAnimation(fig, draw, frames=len(poses))
+        final = out / "trajectory_animation.gif"
+        fd, tmp = tempfile.mkstemp(prefix=".trajectory_animation.", suffix=".gif", dir=out)
+        os.close(fd)
+        try:
+            anim.save(tmp, writer=PillowWriter(fps=12), dpi=80)
+            os.chmod(tmp, 0o644)
+            os.replace(tmp, final)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+        written.append(final)
+    else:
+        folder = out / "trajectory_frames"
+        folder.mkdir(exist_ok=True)
+        for k in range(len(poses)):
+            draw(k)
+            written.append(_save_png(fig, folder / f"frame_{k:03d}.png"))
+    plt.close(fig)
+    return written
+
+
+def write_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, paving: Paving | None = None,
+                     joint: "JointPaving | None" = None) -> list[Path]:
+    """``trajectory.json`` (the --json object plus the certificate) and the figures, atomically."""
+
+    out = Path(out)
+    doc = traj.to_json()
+    doc["certificate"] = traj.certificate()
+    doc["seconds"] = traj.seconds
+    paths = [write_json(out / "trajectory.json", doc)]
+    paths += render_trajectory(traj, geometry, out, paving=paving, joint=joint)
+    return paths

@@ -1,0 +1,233 @@
+"""Certificate files: each claim intervalkin makes, with the evidence a sceptic needs.
+
+The writers here turn the library's results into JSON files; the independent
+checker (:mod:`intervalkin.checker`, ``intervalkin verify DIR``) re-proves them
+from the files alone with arb, without the paving, region or solver code.
+
+Schema (format ``"intervalkin-certificate"``, version 1)
+-------------------------------------------------------
+A certificate folder holds ``index.json`` and one file per claim type::
+
+    index.json   {"format": "intervalkin-certificate", "version": 1, "kind": "index",
+                  "geometry_toml": "<Geometry.to_toml()>", "files": ["dkp.json", ...],
+                  "tool": {"name": "intervalkin", "version": "..."},
+                  "omitted": [{"what": "...", "why": "..."}]}
+    <kind>.json  {"format": ..., "version": 1, "kind": "<kind>",
+                  "geometry_toml": "<the same text as the index>", "precision": 128,
+                  "claims": [{"id": "...", ...}, ...]}
+
+Conventions for every file:
+
+* ``geometry_toml``: the manipulator as the exact decimal strings that were read
+  (:meth:`~intervalkin.core.geometry.Geometry.to_toml`); the checker re-reads it with
+  :func:`~intervalkin.core.geometry.parse_geometry` and requires every file to carry
+  the index's text.
+* Joint vectors are exact: decimal strings ``"14.98"`` when the value is a finite
+  decimal, else ``"p/q"`` (never JSON numbers).
+* A box is ``[[xlo, xhi], [ylo, yhi], [philo, phihi]]`` of binary64 numbers written
+  in shortest round-trip form (Python ``repr``), phi in radians; the box is the
+  set of reals between those binary64 values.
+* ``precision``: arb working precision (bits) of the checker for the claim
+  (a claim's own ``precision`` overrides the file's).
+* ``statement``: human text; the checker never trusts it.
+
+Claim fields by kind (``id`` is unique within its file):
+
+``dkp``
+    ``rho`` (3 exact strings), ``complete`` (bool), ``count``, ``phi0`` (binary64
+    shift of t = tan((phi - phi0)/2), used when complete), ``solutions``:
+    ``[{"box", "det_sign": 1 | -1}]``.  Proves: each box holds exactly one
+    solution, with that sign of det A; with ``complete``, there are no others.
+``joint_cell``
+    ``cell`` (id in the joint paving), ``witness`` (3 exact strings), ``count``,
+    ``n_wa1``, ``n_wa2``, ``phi0``, ``solutions`` as for dkp (always complete).
+    Proves the witness's count and aspect split.  That the whole cell shares
+    them rests on the library's enclosure of g(S) (not re-checked).
+``aspect_distinct``
+    ``boxes``: ``[{"box", "aspect": "WA1" | "WA2", "paving_index"}]``.  Proves
+    each box inside W with that sign of det A on the whole box: two aspects.
+``region_distinct``
+    ``rho``, ``cell``, ``aspect``, ``solutions``: ``[{"box", "det_sign", "piece",
+    "region", "paving_box": {"index", "box", "labels": {"W", "det_positive",
+    "off_Sc"}}}]``.  Proves k distinct solutions of q in the aspect, each inside
+    its paving box, whose W and det labels are re-proved; the off-S_c label and
+    the piece / region ids are the library's (see the claim statement).
+``box_labels``
+    ``seed``, ``population`` (boxes in the paving), ``sample_size``, ``boxes``:
+    ``[{"index", "box", "labels": {"W": 1|2|3, "det_positive": 1|2|3}}]``; the
+    indices are :func:`intervalkin.checker.sample_indices` (seed, population,
+    sample_size).  Labels: 1 OUTSIDE, 2 INSIDE, 3 BOUNDARY (claims nothing).
+``trajectory``
+    one claim per path (id ``"I-J"``): ``rho`` (3 exact strings), ``from``,
+    ``to`` (solution numbers, 1-based in increasing phi, as ``intervalkin dkp``
+    lists them), ``aspect``, ``det_sign``, ``phi0`` and ``solutions`` (the
+    complete solution list of rho, as for dkp: it fixes the numbering),
+    ``start_box``, ``goal_box`` (enclosures of the two end solutions, phi in
+    [-pi, pi]), ``phi_turns`` (the path reaches the goal at its phi plus
+    2 pi phi_turns: phi is unwrapped along the path), ``waypoints`` (m rows
+    [x, y, phi] as hex strings, for the reader) and ``segments``:
+    ``[{"start", "end", "pieces"}]`` exactly as
+    :meth:`~intervalkin.space.trajectory.Trajectory.certificate` gives them: end point
+    enclosures ``[[lo, hi]] * 3`` and pieces ``[[t0, t1], ...]``, every number a
+    binary64 written EXACTLY as a hex string (``float.hex``).  Proves: the
+    straight segments, each from any point of its start enclosure to any point
+    of its end enclosure, keep det A of the aspect's sign and every leg within
+    its limits; they join end to end from the exact start solution to the
+    exact goal solution.
+``counts``
+    one claim per count: ``name`` (``aspects``, ``basic_regions``,
+    ``uniqueness_domains``), ``lower_bound``, ``found`` (the library's number,
+    not certified), ``exact`` (always false), ``support`` (references
+    ``"file#id"`` to the claims that prove the bound).
+
+Writers build each solve claim, then run the checker on it before writing; a
+claim the checker refuses is left out and listed under ``omitted`` in the index
+with the reason (it is never written as if it held).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Sequence
+
+from intervalkin import checker
+from intervalkin.certify.claims import (
+    FORMAT,
+    VERSION,
+    aspect_distinct_claims,
+    box_labels_claim,
+    counts_claims,
+    dkp_claim,
+    joint_cell_claims,
+    region_distinct_claims,
+    trajectory_claims,
+)
+from intervalkin.core.errors import InputError
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.version import __version__
+
+__all__ = ['write_certificates']
+
+
+# --------------------------------------------------------------------------------------
+# Writing
+# --------------------------------------------------------------------------------------
+def _write_atomic(path: Path, doc: dict) -> None:
+    """JSON to ``path`` through a temporary file in the same folder and os.replace."""
+    text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def write_certificates(
+    out_dir: str | Path,
+    geometry: Geometry,
+    *,
+    dkp_results: Sequence = (),
+    joint=None,
+    regions=None,
+    paving=None,
+    box_sample: int = 200,
+    seed: int = 0,
+    precision: int = 128,
+    trajectories: Sequence = (),
+) -> list[Path]:
+    """Write the certificate folder of the given results; return the paths written (index last).
+
+    Parameters
+    ----------
+    out_dir : folder, created if needed.
+    geometry : the manipulator the results are about.
+    dkp_results : :class:`~intervalkin.solve.dkp.DkpResult` objects -> ``dkp.json``.
+    joint : :class:`~intervalkin.space.joint_space.JointPaving` -> ``joint_cell.json`` (each
+        certified cell's witness is re-solved).
+    regions : :class:`~intervalkin.space.basic_region.RegionAnalysis` -> ``aspect_distinct``,
+        ``region_distinct``, ``box_labels`` (on its paving) and ``counts``.
+    paving : a workspace paving used for ``aspect_distinct`` and ``box_labels``
+        when ``regions`` is None.
+    box_sample : number of boxes in the ``box_labels`` sample (0: no sample).
+    seed : seed of the sample (:func:`intervalkin.checker.sample_indices`).
+    trajectories : :class:`~intervalkin.space.trajectory.Trajectory` objects ->
+        ``trajectory.json`` (uncertified ones are omitted).
+    precision : arb bits the checker starts with (raised per claim when needed).
+
+    Every solve claim is re-checked with :mod:`intervalkin.checker` before it
+    is written; refused ones are listed under ``omitted`` in ``index.json``.
+    Each file is written atomically; ``index.json`` is written last.
+    """
+
+    if isinstance(box_sample, bool) or not isinstance(box_sample, int) or box_sample < 0:
+
+        raise InputError(f"box_sample: expected an integer >= 0, got {box_sample!r}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    toml = geometry.to_toml()
+    files: dict[str, list[dict]] = {}
+    omitted: list[dict] = []
+
+    dkp_list = []
+    for k, res in enumerate(dkp_results):
+        got, why = dkp_claim(geometry, res, f"q-{k}", precision)
+        (dkp_list.append(got) if got else omitted.append({"what": f"dkp q-{k}", "why": why}))
+    if dkp_list:
+        files["dkp"] = dkp_list
+    if joint is not None:
+        cells, om = joint_cell_claims(geometry, joint, precision)
+        omitted += om
+        files["joint_cell"] = cells
+    pav = regions.paving if regions is not None else paving
+    if pav is not None:
+        asp, om = aspect_distinct_claims(geometry, pav, precision)
+        omitted += om
+        files["aspect_distinct"] = asp
+    if regions is not None:
+        reg, om = region_distinct_claims(geometry, regions, joint, precision)
+        omitted += om
+        files["region_distinct"] = reg
+    if pav is not None and box_sample > 0:
+        files["box_labels"] = [box_labels_claim(pav, box_sample, seed, precision)]
+    if trajectories:
+        trj, om = trajectory_claims(geometry, trajectories, precision)
+        omitted += om
+        files["trajectory"] = trj
+    if regions is not None:
+        aspect_refs = [f"aspect_distinct.json#{c['id']}" for c in files.get("aspect_distinct", [])]
+        solve_refs = ([f"joint_cell.json#{c['id']}" for c in files.get("joint_cell", [])]
+                      + [f"dkp.json#{c['id']}" for c in files.get("dkp", [])])
+        files["counts"] = counts_claims(regions, aspect_refs, solve_refs)
+
+    written = []
+    for kind in checker.KINDS:
+        if kind not in files:
+            continue
+        path = out / f"{kind}.json"
+        _write_atomic(path, {"format": FORMAT, "version": VERSION, "kind": kind, "geometry_toml": toml,
+                             "precision": precision, "claims": files[kind]})
+        written.append(path)
+    index = {
+        "format": FORMAT,
+        "version": VERSION,
+        "kind": "index",
+        "geometry_toml": toml,
+        "files": [p.name for p in written],
+        "tool": {"name": "intervalkin", "version": __version__},
+        "omitted": omitted,
+        "how_to_check": "intervalkin verify DIR (or intervalkin.checker.verify_directory(DIR))",
+    }
+    _write_atomic(out / checker.INDEX, index)
+    written.append(out / checker.INDEX)
+    return written

@@ -1,0 +1,85 @@
+"""The independent checker of intervalkin certificate files (``intervalkin verify DIR``).
+
+A certificate folder (written by :func:`intervalkin.certify.writer.write_certificates`;
+schema in that module) states claims with their evidence.  This module re-proves
+every claim from the files alone, in arb ball arithmetic (python-flint), and
+prints one line per claim.  Its trusted base is small on purpose:
+
+* the Python standard library and python-flint (arb, acb, arb_poly, acb_poly,
+  arb_mat; ``acb_poly.roots`` for certified complex root isolation);
+* :mod:`intervalkin.core.geometry` (reads the geometry TOML stored in the files as
+  exact decimals; constants as exact rationals and surds) and
+  :mod:`intervalkin.core.errors`;
+* the few formulas written out below (rho_i^2, det A, F, F', the reduced
+  sextic), re-derived here on purpose instead of imported from
+  :mod:`intervalkin.kinematics` or :mod:`intervalkin.solve.dkp`.
+
+It never imports the paving, predicate, joint, region, dkp or analysis code
+(``tests/test_certificates.py::test_checker_imports_none_of_the_checked_modules``).
+What each claim type proves, and what it still trusts, is in
+``proofs/lemma-checker.md``.
+
+Re-proved per claim type
+------------------------
+``dkp`` / ``joint_cell``
+    Each solution box holds exactly one solution of the ORIGINAL system
+    F_i = |B_i - A_i|^2 - rho_i^2 (Krawczyk, the checker's own preconditioner,
+    strict interior inclusion); det A has the declared sign on the whole box;
+    the boxes are pairwise disjoint with phi read modulo 2 pi; and, for a claim
+    of completeness, the checker rebuilds the reduced sextic in t = tan((phi -
+    phi0)/2) by its own real-polynomial derivation, proves its leading
+    coefficient non-zero, isolates its roots (``acb_poly.roots``), counts the
+    real ones, proves the 2x2 system regular at each, and requires that count
+    to equal the number of boxes.  A ``joint_cell`` claim also checks that the
+    witness lies in the joint limits and that its count and aspect split are
+    the ones declared.
+``aspect_distinct``
+    Each box lies in W (rho_min_i^2 <= rho_i^2 <= rho_max_i^2 on the whole box)
+    and det A has the declared sign on the whole box (box subdivided in arb
+    when the natural enclosure is too wide); the two signs are opposite.
+``region_distinct``
+    The joint vector's listed solutions are re-proved (Krawczyk, one aspect,
+    pairwise disjoint), each solution box lies in its stated paving box, and
+    that paving box's W and det-sign labels are re-proved in arb.  The
+    "off S_c" label and the box-to-piece map are NOT re-checked (they need the
+    joint-space enclosure of g(S)); the claim text says so.
+``box_labels``
+    Every INSIDE / OUTSIDE label of the sampled boxes (W and det_positive) is
+    re-proved in arb over the whole box, subdividing when needed; BOUNDARY
+    labels claim nothing.  The sample indices are re-derived from the seed.
+``trajectory``
+    The joint vector's complete solution list is re-proved as for ``dkp`` (it
+    fixes the solution numbers: increasing phi in [-pi, pi]); the start and
+    goal enclosures each hold exactly one solution (Krawczyk), lie in the
+    listed solutions ``from`` and ``to``, and carry det A of the stated sign.
+    For every piece [t0, t1] of every straight segment A + t (B - A) (A, B
+    the segment's end enclosures), the ball A + [t0, t1] (B - A) is formed in
+    arb and det A is proved of the aspect's sign and rho_min_i^2 <= rho_i^2 <=
+    rho_max_i^2 proved on it (the t range bisected while undecided, within
+    :data:`PIECE_BUDGET`); the pieces tile [0, 1]; consecutive segments share
+    their end enclosure; the start enclosure lies in the first segment's
+    start, and the goal enclosure shifted by 2 pi phi_turns (phi unwrapped)
+    in the last segment's end.
+``counts``
+    Each declared lower bound is recomputed from the referenced claims that
+    verified (rules in :func:`_count_bound`); a declared lower bound larger than
+    the recomputed one, or a count declared exact, is refused.
+"""
+
+from intervalkin.checker.claims import box_label_proved, check_claim
+from intervalkin.checker.folder import CheckResult, verify_directory
+from intervalkin.checker.parse import FORMAT, INDEX, KINDS, VERSION, CertificateFormatError, parse_exact, sample_indices
+
+__all__ = [
+    "FORMAT",
+    "VERSION",
+    "KINDS",
+    "INDEX",
+    "CertificateFormatError",
+    "CheckResult",
+    "parse_exact",
+    "sample_indices",
+    "check_claim",
+    "box_label_proved",
+    "verify_directory",
+]

@@ -1,0 +1,236 @@
+"""Vectorized interval arithmetic over numpy, rounded outward, and the bridge to arb.
+
+An :class:`Interval` holds two float64 arrays ``lo`` and ``hi`` of one shape: the
+k-th entry encloses the real interval [lo[k], hi[k]].  Every operation returns an
+enclosure of the exact range of the operation over its operands (the inclusion
+property), with rounding errors accounted for:
+
+* ``+ - * /`` and ``sqrt`` are correctly rounded in IEEE 754 (round to nearest),
+  so the exact result lies within half an ulp of the float result; moving the
+  float result one ulp outward (``np.nextafter`` toward -inf / +inf) encloses it.
+  This module is the only place that rounds (proofs/lemma-outward-rounding.md).
+* ``cos`` and ``sin`` of numpy are not correctly rounded.  We rely on the bound
+  ``|fl(cos t) - cos t| <= TRIG_ABS_ERROR`` (and the same for sin) for
+  ``|t| <= TRIG_MAX_ARG``, a bound over 60 times the worst case observed (5.6e-17, a quarter of an ulp of 1)
+  and checked against arb on many thousands of arguments by
+  ``tests/test_interval.py::test_trig_error_bound`` (proofs/lemma-trig-enclosure.md).
+  Whether an interval holds an extremum of cos or sin is decided with an
+  enclosure [PI_LO, PI_HI] of pi, conservatively (a possible extremum is included).
+
+Interval comparisons never return a bare bool meaning "true": use
+:func:`certainly_positive` and friends, where False means "not proved".
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Union
+
+import numpy as np
+
+__all__ = ['PI_LO', 'PI_HI', 'TRIG_ABS_ERROR', 'TRIG_MAX_ARG', 'round_down', 'round_up', 'Interval', 'certainly_positive', 'certainly_negative', 'sign_label']
+
+_NEG_INF = -np.inf
+_POS_INF = np.inf
+
+#: float64 enclosure of pi: PI_LO < pi < PI_HI (math.pi is the float just below pi).
+PI_LO = 3.141592653589793
+PI_HI = float(np.nextafter(PI_LO, np.inf))
+#: Absolute error bound of numpy's float64 cos and sin on [-TRIG_MAX_ARG, TRIG_MAX_ARG].
+TRIG_ABS_ERROR = 2.0**-48
+TRIG_MAX_ARG = 64.0
+
+
+def round_down(x: np.ndarray) -> np.ndarray:
+    """The float just below x: a lower bound of any real within one ulp of x."""
+    return np.nextafter(x, _NEG_INF)
+
+
+def round_up(x: np.ndarray) -> np.ndarray:
+    """The float just above x: an upper bound of any real within one ulp of x."""
+    return np.nextafter(x, _POS_INF)
+
+
+Operand = Union["Interval", float, int, np.ndarray]
+
+
+def _as_interval(v: Operand) -> "Interval":
+    if isinstance(v, Interval):
+        return v
+    if not isinstance(v, (float, int, np.ndarray, np.floating, np.integer)):
+        raise TypeError(f"cannot combine an Interval with {type(v).__name__}")
+    a = np.asarray(v, dtype=np.float64)
+    # A float operand is taken as the exact number it represents (a point).
+    return Interval(a, a)
+
+
+@dataclass(frozen=True, eq=False)
+class Interval:
+    """An array of closed intervals [lo, hi] (float64, broadcastable shapes)."""
+
+    lo: np.ndarray
+    hi: np.ndarray
+
+    # --- construction -----------------------------------------------------------------
+    @staticmethod
+    def point(x: np.ndarray | float) -> "Interval":
+        """Degenerate intervals [x, x] for floats x (exact: floats are exact reals)."""
+        a = np.asarray(x, dtype=np.float64)
+        return Interval(a, a)
+
+    @staticmethod
+    def from_bounds(lo, hi) -> "Interval":
+        return Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64))
+
+    # --- views ------------------------------------------------------------------------
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return np.broadcast_shapes(np.shape(self.lo), np.shape(self.hi))
+
+    def mid(self) -> np.ndarray:
+        """A float inside each interval (not necessarily the exact midpoint)."""
+        m = 0.5 * self.lo + 0.5 * self.hi
+        return np.minimum(np.maximum(m, self.lo), self.hi)
+
+    def width(self) -> np.ndarray:
+        """Upper bound of hi - lo."""
+        return round_up(self.hi - self.lo)
+
+    def __getitem__(self, idx) -> "Interval":
+        lo, hi = np.broadcast_arrays(self.lo, self.hi)
+        return Interval(lo[idx], hi[idx])
+
+    def contains_point(self, x) -> np.ndarray:
+        return (self.lo <= x) & (x <= self.hi)
+
+    def intersect(self, other: "Interval") -> "Interval":
+        """Intersection of two enclosures of the same quantity (keeps the sharper bound).
+
+        Both operands must enclose the same real set, so the intersection is never
+        empty for sound inputs; an empty result signals unsoundness and is asserted.
+        """
+        lo = np.maximum(self.lo, other.lo)
+        hi = np.minimum(self.hi, other.hi)
+        assert not np.any(lo > hi), "intersection of two enclosures of one quantity is empty: unsound evaluation"
+        return Interval(lo, hi)
+
+    def hull(self, other: "Interval") -> "Interval":
+        return Interval(np.minimum(self.lo, other.lo), np.maximum(self.hi, other.hi))
+
+    # --- arithmetic ---------------------------------------------------------------------
+    def __neg__(self) -> "Interval":
+        return Interval(-self.hi, -self.lo)
+
+    def __add__(self, other: Operand) -> "Interval":
+        o = _as_interval(other)
+        return Interval(round_down(self.lo + o.lo), round_up(self.hi + o.hi))
+
+    __radd__ = __add__
+
+    def __sub__(self, other: Operand) -> "Interval":
+        o = _as_interval(other)
+        return Interval(round_down(self.lo - o.hi), round_up(self.hi - o.lo))
+
+    def __rsub__(self, other: Operand) -> "Interval":
+        return _as_interval(other) - self
+
+    def __mul__(self, other: Operand) -> "Interval":
+        o = _as_interval(other)
+        p1 = self.lo * o.lo
+        p2 = self.lo * o.hi
+        p3 = self.hi * o.lo
+        p4 = self.hi * o.hi
+        lo = np.minimum(np.minimum(p1, p2), np.minimum(p3, p4))
+        hi = np.maximum(np.maximum(p1, p2), np.maximum(p3, p4))
+        return Interval(round_down(lo), round_up(hi))
+
+    __rmul__ = __mul__
+
+    def __truediv__(self, other: Operand) -> "Interval":
+        o = _as_interval(other)
+        zero_in = (o.lo <= 0) & (o.hi >= 0)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # inf bounds are still sound
+            q1 = self.lo / o.lo
+            q2 = self.lo / o.hi
+            q3 = self.hi / o.lo
+            q4 = self.hi / o.hi
+        lo = np.minimum(np.minimum(q1, q2), np.minimum(q3, q4))
+        hi = np.maximum(np.maximum(q1, q2), np.maximum(q3, q4))
+        lo = np.where(zero_in, _NEG_INF, round_down(lo))
+        hi = np.where(zero_in, _POS_INF, round_up(hi))
+        return Interval(lo, hi)
+
+    def __rtruediv__(self, other: Operand) -> "Interval":
+        return _as_interval(other) / self
+
+    def sqr(self) -> "Interval":
+        """x^2 over the interval (tighter than x * x: one occurrence of x)."""
+        a = self.lo * self.lo
+        b = self.hi * self.hi
+        hi = round_up(np.maximum(a, b))
+        lo = np.where(self.lo >= 0, a, np.where(self.hi <= 0, b, 0.0))
+        lo = np.maximum(round_down(lo), 0.0)
+        return Interval(lo, hi)
+
+    def sqrt(self) -> "Interval":
+        """sqrt over the part of the interval where it is defined (x >= 0)."""
+        lo = np.maximum(round_down(np.sqrt(np.maximum(self.lo, 0.0))), 0.0)
+        hi = round_up(np.sqrt(np.maximum(self.hi, 0.0)))
+        return Interval(lo, hi)
+
+    def cos(self) -> "Interval":
+        """cos over the interval; extrema located with the enclosure of pi."""
+        return _trig(self, np.cos, max_at=0, min_at=2)
+
+    def sin(self) -> "Interval":
+        """sin over the interval; extrema located with the enclosure of pi."""
+        return _trig(self, np.sin, max_at=1, min_at=3)
+
+
+def _may_contain_multiple(lo: np.ndarray, hi: np.ndarray, j: int) -> np.ndarray:
+    """True where [lo, hi] may contain a point (4k + j) * pi / 2 for an integer k.
+
+    The enclosure [n * PI_LO / 2, n * PI_HI / 2] (rounded outward) of n * pi / 2 is
+    tested against [lo, hi] for the three candidate k around hi; the interval is
+    shorter than 2 pi when this is called, so no other k can fall inside.
+    """
+    k0 = np.floor((hi - j * PI_LO / 2) / (2 * PI_LO))
+    hit = np.zeros(np.shape(lo), dtype=bool)
+    for dk in (-1.0, 0.0, 1.0):
+        n = 4.0 * (k0 + dk) + j
+        a = n * (PI_LO / 2)
+        b = n * (PI_HI / 2)
+        elo = round_down(np.minimum(a, b))
+        ehi = round_up(np.maximum(a, b))
+        hit |= (elo <= hi) & (ehi >= lo)
+    return hit
+
+
+def _trig(x: Interval, f, max_at: int, min_at: int) -> Interval:
+    lo, hi = np.broadcast_arrays(x.lo, x.hi)
+    flo = f(lo)
+    fhi = f(hi)
+    rlo = np.minimum(flo, fhi) - TRIG_ABS_ERROR
+    rhi = np.maximum(flo, fhi) + TRIG_ABS_ERROR
+    rlo = np.where(_may_contain_multiple(lo, hi, min_at), -1.0, rlo)
+    rhi = np.where(_may_contain_multiple(lo, hi, max_at), 1.0, rhi)
+    wide = ~((hi - lo) < 2 * PI_LO) | ~(np.abs(lo) <= TRIG_MAX_ARG) | ~(np.abs(hi) <= TRIG_MAX_ARG)
+    rlo = np.where(wide, -1.0, np.maximum(round_down(rlo), -1.0))
+    rhi = np.where(wide, 1.0, np.minimum(round_up(rhi), 1.0))
+    return Interval(rlo, rhi)
+
+
+# --- sign predicates -------------------------------------------------------------------------
+def certainly_positive(x: Interval) -> np.ndarray:
+    """True where every point of the interval is > 0; False means "not proved"."""
+    return x.lo > 0
+
+
+def certainly_negative(x: Interval) -> np.ndarray:
+    """True where every point of the interval is < 0; False means "not proved"."""
+    return x.hi < 0
+
+
+def sign_label(x: Interval) -> np.ndarray:
+    """int8 array: 1 certainly positive, -1 certainly negative, 0 undecided."""
+    return np.where(x.lo > 0, 1, np.where(x.hi < 0, -1, 0)).astype(np.int8)

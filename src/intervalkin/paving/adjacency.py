@@ -1,0 +1,235 @@
+"""Octree pavings of the workspace domain: subdivision, tri-state labels, face adjacency.
+
+A paving is a set of axis-aligned boxes (x, y, phi) that tile a domain.  Each box
+is stored twice, consistently:
+
+* as integer coordinates ``(level, i, j, k)``: at ``level`` the domain is cut into
+  ``2**level`` slices per axis and the box is slice ``(i, j, k)``;
+* as float bounds ``lo``, ``hi`` of shape (n, 3), computed from the integers by one
+  formula (``lo = domain_lo + i * (width * 2**-level)``), so that two boxes that
+  share a face share it bit for bit, whatever their levels.
+
+Depth d means leaf width = domain width / 2**d on every axis.  Only undecided boxes
+are split, level by level, with numpy over all boxes of a level (no Python loop
+per box).
+
+Labels are ``uint8`` arrays of :class:`Label` flags: OUTSIDE = 1 (the predicate
+fails at every point of the box), INSIDE = 2 (it holds at every point),
+BOUNDARY = 3 (not decided).  ``a & b`` keeps the sharper of two sound labels of the
+same predicate; 0 would mean a contradiction, i.e. an unsound evaluation, and is
+asserted against.
+
+The phi axis is periodic.  The phi range of the domain is widened outward to
+[-PI_HI, PI_HI] (PI_HI is the float just above pi), so the boxes cover every angle
+and the two boxes on either side of the seam overlap (by ~1e-16) modulo 2 pi:
+their union is connected, which is what the seam adjacency claims.
+
+Face adjacency (``shares_face``): two boxes are adjacent when they share a 2-D
+piece of a face (a common edge or corner is not enough).  In an x-phi section
+(faces are drawn as edges)::
+
+      phi = +pi  +---------+----+----+      ^ phi
+                 |         | b  | c  |      |
+                 |    a    +----+----+      +--> x
+                 |         | d  | e  |
+                 +----+----+----+----+      a-b, a-d, a-f, a-g: share a face piece
+                 | f  | g  |         |      d-h, e-h, g-h, j-h: share a face piece
+                 +----+----+    h    |      a-h, d-g: a corner only, NOT adjacent
+                 | i  | j  |         |
+      phi = -pi  +----+----+---------+
+                 seam: phi = +pi is phi = -pi, so the top faces of a, b, c touch
+                 the bottom faces of i, j, h: a-i, a-j, b-h, c-h are adjacent too.
+
+All adjacency pairs are computed in bulk from the integer coordinates: along an
+axis, a "+" face and a "-" face on the same plane overlap in 2-D exactly when one
+dyadic square contains the other, so each face looks up its ancestors' keys
+(one sorted search per level).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ['shares_face', 'shares_face_bruteforce', 'adjacency_graph', 'component_labels', 'connected_components']
+
+
+# --------------------------------------------------------------------------------------
+# Adjacency
+# --------------------------------------------------------------------------------------
+def _face_keys(plane, lev, a, b, nbits):
+    return ((plane * 64 + lev) << (2 * nbits)) | (a << nbits) | b
+
+
+def shares_face(level: np.ndarray, ijk: np.ndarray, depth: int, periodic=(False, False, True)) -> np.ndarray:
+    """Face-adjacent pairs of a paving, as a (2, m) int64 array with row 0 < row 1.
+
+    Parameters
+    ----------
+    level : (n,) ints, ijk : (n, 3) ints, integer coordinates of boxes that tile
+        (part of) the domain without overlapping; depth >= max(level).
+    periodic : which axes wrap (default: phi, so phi = +pi touches phi = -pi).
+
+    Two boxes are adjacent when they share a 2-D piece of a face.  Cost:
+    O((depth + 1) * n log n) for each of the three axes.
+    """
+    level = np.asarray(level, dtype=np.int64)
+    ijk = np.asarray(ijk, dtype=np.int64)
+    n = level.shape[0]
+    if n == 0:
+        return np.zeros((2, 0), dtype=np.int64)
+    nfine = np.int64(1) << depth
+    shift = depth - level
+    nbits = depth + 1
+    pairs = []
+    for ax in range(3):
+        o1, o2 = [a for a in range(3) if a != ax]
+        plus_plane = (ijk[:, ax] + 1) << shift
+        minus_plane = ijk[:, ax] << shift
+        if periodic[ax]:
+            plus_plane = np.where(plus_plane == nfine, 0, plus_plane)
+        # "+" faces keyed at their own level
+        pk = _face_keys(plus_plane, level, ijk[:, o1], ijk[:, o2], nbits)
+        order = np.argsort(pk, kind="stable")
+        pk_sorted = pk[order]
+        mk = _face_keys(minus_plane, level, ijk[:, o1], ijk[:, o2], nbits)
+        morder = np.argsort(mk, kind="stable")
+        mk_sorted = mk[morder]
+        for L in range(depth + 1):
+            # minus faces of level >= L look for a plus face of level L containing them
+            sel = np.flatnonzero(level >= L)
+            d = level[sel] - L
+            key = _face_keys(minus_plane[sel], np.full(sel.size, L), ijk[sel, o1] >> d, ijk[sel, o2] >> d, nbits)
+            pos = np.searchsorted(pk_sorted, key)
+            pos = np.minimum(pos, pk_sorted.size - 1)
+            hit = pk_sorted[pos] == key
+            pairs.append(np.stack([order[pos[hit]], sel[hit]]))
+            # plus faces of level > L look for a minus face of level L containing them
+            sel = np.flatnonzero(level > L)
+            d = level[sel] - L
+            key = _face_keys(plus_plane[sel], np.full(sel.size, L), ijk[sel, o1] >> d, ijk[sel, o2] >> d, nbits)
+            pos = np.minimum(np.searchsorted(mk_sorted, key), mk_sorted.size - 1)
+            hit = mk_sorted[pos] == key
+            pairs.append(np.stack([sel[hit], morder[pos[hit]]]))
+    p = np.concatenate(pairs, axis=1)
+    p = p[:, p[0] != p[1]]
+    p = np.sort(p, axis=0)
+    if p.size == 0:
+        return np.zeros((2, 0), dtype=np.int64)
+    keys = np.sort(p[0] * np.int64(n) + p[1])  # 1-D keys: far faster than unique(axis=1)
+    keys = keys[np.concatenate(([True], keys[1:] != keys[:-1]))]
+    return np.stack([keys // n, keys % n])
+
+
+def shares_face_bruteforce(level, ijk, depth: int, periodic=(False, False, True)) -> np.ndarray:
+    """Reference O(n^2) version of :func:`shares_face` (for tests, small n only)."""
+    level = np.asarray(level, dtype=np.int64)
+    ijk = np.asarray(ijk, dtype=np.int64)
+    shift = (depth - level)[:, None]
+    lo = ijk << shift
+    hi = (ijk + 1) << shift
+    nfine = 1 << depth
+    out = []
+    n = len(level)
+    for a in range(n):
+        for b in range(a + 1, n):
+            for ax in range(3):
+                others = [o for o in range(3) if o != ax]
+                overlap = all(min(hi[a, o], hi[b, o]) - max(lo[a, o], lo[b, o]) > 0 for o in others)
+                if not overlap:
+                    continue
+                touch = hi[a, ax] == lo[b, ax] or hi[b, ax] == lo[a, ax]
+                if periodic[ax]:
+                    touch = touch or (hi[a, ax] == nfine and lo[b, ax] == 0) or (hi[b, ax] == nfine and lo[a, ax] == 0)
+                if touch:
+                    out.append((a, b))
+                    break
+    return np.array(out, dtype=np.int64).reshape(-1, 2).T
+
+
+def adjacency_graph(n: int, edges: np.ndarray, nodes: np.ndarray | None = None):
+    """A networkx Graph on box indices ``nodes`` (default all n) with the given (2, m) edges.
+
+    Edges with an endpoint outside ``nodes`` are dropped.
+    """
+    import networkx as nx
+
+    g = nx.Graph()
+    if nodes is None:
+        nodes = np.arange(n)
+    nodes = np.asarray(nodes)
+    g.add_nodes_from(nodes.tolist())
+    keep = np.zeros(n, dtype=bool)
+    keep[nodes] = True
+    e = edges[:, keep[edges[0]] & keep[edges[1]]]
+    g.add_edges_from(zip(e[0].tolist(), e[1].tolist()))
+    return g
+
+
+def component_labels(n: int, edges: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """Connected components of the boxes selected by ``mask`` under ``edges``, in bulk.
+
+    Returns (n,) int32: component id 0..c-1 for selected boxes (numbered by their
+    smallest box index, ids ordered by decreasing size), -1 elsewhere.  Union by
+    minimum label with pointer jumping (numpy, no Python loop per box).
+    """
+    mask = np.asarray(mask, dtype=bool)
+    e = edges[:, mask[edges[0]] & mask[edges[1]]]
+    parent = np.arange(n, dtype=np.int64)
+    u, v = e[0], e[1]
+    while True:
+        pu, pv = parent[u], parent[v]
+        diff = pu != pv
+        if not np.any(diff):
+            break
+        hi_ = np.maximum(pu[diff], pv[diff])
+        lo_ = np.minimum(pu[diff], pv[diff])
+        np.minimum.at(parent, hi_, lo_)
+        while True:  # pointer jumping until every node points at a root
+            pp = parent[parent]
+            if np.array_equal(pp, parent):
+                break
+            parent = pp
+    out = np.full(n, -1, dtype=np.int32)
+    roots = parent[mask]
+    if roots.size == 0:
+        return out
+    uniq, inv, counts = np.unique(roots, return_inverse=True, return_counts=True)
+    order = np.argsort(-counts, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.size)
+    out[mask] = rank[inv].astype(np.int32)
+    return out
+
+
+def grow_labels(n: int, edges: np.ndarray, seeds: np.ndarray, layer: np.ndarray, max_steps: int = 100_000) -> np.ndarray:
+    """Multi-source growth of integer labels into the ``layer`` nodes (nearest seed by graph distance).
+
+    ``seeds`` (n,) holds a label >= 0 on seed nodes and -1 elsewhere; each step
+    gives every unlabelled layer node adjacent to a labelled node the smallest
+    neighbouring label.  Returns the grown labels (layer nodes out of reach
+    stay -1).  Cost: one pass over the edges that touch the layer per step.
+    """
+    lab = np.asarray(seeds, dtype=np.int64).copy()
+    layer = np.asarray(layer, dtype=bool)
+    edges = edges[:, layer[edges[0]] | layer[edges[1]]]  # edges between seeds never change a label
+    u, v = edges
+    big = np.iinfo(np.int64).max
+    for _ in range(max_steps):
+        a = (lab[u] >= 0) & (lab[v] < 0) & layer[v]
+        b = (lab[v] >= 0) & (lab[u] < 0) & layer[u]
+        if not (np.any(a) or np.any(b)):
+            break
+        new = np.full(n, big, dtype=np.int64)
+        np.minimum.at(new, v[a], lab[u[a]])
+        np.minimum.at(new, u[b], lab[v[b]])
+        upd = new != big
+        lab[upd] = new[upd]
+    return lab
+
+
+def connected_components(n: int, edges: np.ndarray, mask: np.ndarray) -> list[frozenset]:
+    """Components (frozensets of box indices) of the selected boxes, via networkx."""
+    import networkx as nx
+
+    g = adjacency_graph(n, edges, np.flatnonzero(mask))
+    return [frozenset(c) for c in nx.connected_components(g)]

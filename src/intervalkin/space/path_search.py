@@ -1,0 +1,332 @@
+"""Certified non-singular trajectories between assembly modes of one aspect.
+
+The paper (section 3.2, Table 1) observes that solutions 2, 3 and 6 of the joint
+vector rho = (14.98, 15.38, 12.0) lie in one aspect WA1, so the platform can move
+from one to another without meeting a type-2 singularity; section 5.2 and
+Figure 13 add that such a motion must pass through an intermediate basic region,
+whose image is a joint-space domain with only two solutions.  This module builds
+such a motion and PROVES it non-singular.
+
+Construction
+------------
+1. The two solutions are the certified direct-kinematic boxes of
+   :func:`dkp.solve` (numbered from 1 in increasing phi, as ``intervalkin dkp``
+   prints them).  Opposite certified signs of det A put them in different
+   aspects: then no non-singular path exists and :class:`NoPathError` says so.
+2. A shortest path (A*, exact for the metric below) in the face-adjacency graph
+   of the paving boxes certified INSIDE the aspect, from the box nearest the
+   start solution to the box nearest the goal.  Edge weight: the distance of the
+   box centres in the metric ``sqrt(dx^2 + dy^2 + (L dphi)^2)``, dphi taken
+   modulo 2 pi and L the root-mean-square distance of the platform points from
+   B1 (so a rotation costs about what it moves the platform).
+3. Waypoints: the start solution, the centre of the face piece shared by each
+   pair of consecutive boxes, the goal solution.  Each straight segment between
+   them lies in one certified box.
+4. Smoothing: a waypoint is dropped when the straight segment that skips it is
+   itself certified (step 5); the farthest certifiable waypoint is searched by
+   doubling then bisection.
+
+phi convention
+--------------
+Waypoints carry an UNWRAPPED phi: phi is continuous along the path, it starts at
+the start solution's phi (in (-pi, pi]) and may leave (-pi, pi] when the path
+crosses the seam phi = +-pi.  The last waypoint is the goal solution's phi plus
+``2 pi * phi_turns``.  Take phi modulo 2 pi to get the usual pose.  The
+kinematics are 2 pi periodic in phi, so nothing else changes.
+
+Certificate (proofs/lemma-trajectory-certificate.md)
+----------------------------------------------------
+The motion is the concatenation of the exact straight segments
+P(t) = A + t (B - A), t in [0, 1], between consecutive waypoints, where the
+first A and the last B are the EXACT solutions (known through their enclosures)
+and the other waypoints are the floats stored.  For each segment, [0, 1] is cut
+into pieces [t0, t1]; the interval expression A + [t0, t1] (B - A) (outward
+rounded, A and B as intervals) is a box containing the piece of the segment,
+and on that box :func:`kinematics.det_a_interval` is proved of the aspect's sign
+and :func:`kinematics.rho_sq_interval` proved within [rho_min^2, rho_max^2] for
+every leg.  Failing pieces are bisected; past :data:`MAX_BISECTIONS` halvings
+the segment is not certified (``certified`` False, with the reason).  This test
+does not use the paving at all: the paving only proposes the path.
+
+Also reported, with what each claim rests on:
+
+* the basic regions crossed (when a :class:`~intervalkin.space.basic_region.RegionAnalysis`
+  is given): region ids of the paving leaves met by points sampled along the
+  path at steps below half the finest leaf width, consecutive repeats merged,
+  -1 ("layer") where the leaf carries no region (the enclosure of S_c or an
+  undecided sheet).  Sampled, so a region touched only between two samples
+  could be missed;
+* the joint-space image (when a :class:`~intervalkin.space.joint_space.JointPaving` is
+  given): each piece of each segment is enclosed in a box, its interval image
+  g(box) computed, and :meth:`JointPaving.cell_of_boxes` names the cell that
+  contains it: a certified statement "this piece maps into cell c", whose count
+  is certified.  Pieces whose image may meet g(S) are reported as "layer".
+  Unlike ``cell_at`` on rounded joint vectors, this covers every point of the path.
+
+In both sequences a layer stretch between two visits of the same region (or
+cell) is merged into it: the path left the certified part and came back, and
+what it met meanwhile is not resolved at this depth.  The raw per-sample region
+ids are kept in ``Trajectory.sample_region``.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+
+import numpy as np
+
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import PI_HI, PI_LO, Interval
+from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
+from intervalkin.paving.labels import Label
+from intervalkin.paving.tree import Paving
+from intervalkin.space.segment import certify_segment
+
+
+# --------------------------------------------------------------------------------------
+# Shortest path in the box graph
+# --------------------------------------------------------------------------------------
+def _metric_length(geometry: Geometry) -> float:
+    """L: root-mean-square distance of the three platform points from B1."""
+    return math.sqrt(sum(float(geometry.platform_radius_sq(i)) for i in range(3)) / 3.0)
+
+
+def _wrap(d: np.ndarray) -> np.ndarray:
+    """d modulo 2 pi into [-pi, pi)."""
+    return np.mod(d + math.pi, _TWO_PI) - math.pi
+
+
+def _dist(a: np.ndarray, b: np.ndarray, L: float) -> np.ndarray:
+    dphi = _wrap(b[..., 2] - a[..., 2])
+    return np.sqrt((b[..., 0] - a[..., 0]) ** 2 + (b[..., 1] - a[..., 1]) ** 2 + (L * dphi) ** 2)
+
+
+def _point_box_distance(p: np.ndarray, lo: np.ndarray, hi: np.ndarray, L: float) -> np.ndarray:
+    dx = np.maximum(np.maximum(lo[:, 0] - p[0], p[0] - hi[:, 0]), 0.0)
+    dy = np.maximum(np.maximum(lo[:, 1] - p[1], p[1] - hi[:, 1]), 0.0)
+    best = np.full(lo.shape[0], np.inf)
+    for shift in (-_TWO_PI, 0.0, _TWO_PI):
+        ph = p[2] + shift
+        best = np.minimum(best, np.maximum(np.maximum(lo[:, 2] - ph, ph - hi[:, 2]), 0.0))
+    return np.sqrt(dx * dx + dy * dy + (L * best) ** 2)
+
+
+def _shortest_box_path(paving: Paving, edges: np.ndarray, name: str, start: np.ndarray, goal: np.ndarray,
+                       L: float) -> np.ndarray | None:
+    """Indices of the boxes of a shortest path (A*), or None when start and goal are not connected."""
+    inside = paving.labels[name] == Label.INSIDE
+    nodes = np.flatnonzero(inside)
+    if nodes.size == 0:
+        return None
+    lo, hi = paving.lo[nodes], paving.hi[nodes]
+    centre = 0.5 * (lo + hi)
+    s = int(np.argmin(_point_box_distance(start, lo, hi, L)))
+    t = int(np.argmin(_point_box_distance(goal, lo, hi, L)))
+    local = np.full(len(paving), -1, dtype=np.int64)
+    local[nodes] = np.arange(nodes.size)
+    e = edges[:, inside[edges[0]] & inside[edges[1]]]
+    u = np.concatenate([local[e[0]], local[e[1]]])
+    v = np.concatenate([local[e[1]], local[e[0]]])
+    w = _dist(centre[u], centre[v], L)
+    order = np.argsort(u, kind="stable")
+    u, v, w = u[order], v[order], w[order]
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(u, minlength=nodes.size))]).tolist()
+    nbr, wt = v.tolist(), w.tolist()
+    h = _dist(centre, centre[t], L).tolist()  # consistent heuristic: the same metric
+    dist = {s: 0.0}
+    prev = {s: -1}
+    heap = [(h[s], 0.0, s)]
+    closed = set()
+    while heap:
+        _, g, a = heapq.heappop(heap)
+        if a in closed:
+            continue
+        if a == t:
+            break
+        closed.add(a)
+        for k in range(indptr[a], indptr[a + 1]):
+            b = nbr[k]
+            nd = g + wt[k]
+            if nd < dist.get(b, math.inf):
+                dist[b] = nd
+                prev[b] = a
+                heapq.heappush(heap, (nd + h[b], nd, b))
+    if t not in prev:
+        return None
+    path = [t]
+    while prev[path[-1]] >= 0:
+        path.append(prev[path[-1]])
+    return nodes[np.array(path[::-1], dtype=np.int64)]
+
+
+def _crossing_waypoints(paving: Paving, path: np.ndarray, start_phi: float) -> tuple[np.ndarray, np.ndarray]:
+    """Centres of the shared face pieces along a box path, phi unwrapped; also each box's phi offset."""
+    lo, hi = paving.lo[path], paving.hi[path]
+    offs = np.zeros(len(path))
+    c0 = 0.5 * (lo[0, 2] + hi[0, 2])
+    offs[0] = _TWO_PI * round((start_phi - c0) / _TWO_PI)
+    points = []
+    for k in range(len(path) - 1):
+        a_lo, a_hi, b_lo, b_hi = lo[k], hi[k], lo[k + 1], hi[k + 1]
+        shift = 0.0
+        if a_hi[2] == PI_HI and b_lo[2] == -PI_HI and not (b_lo[2] <= a_hi[2] and a_lo[2] <= b_hi[2]):
+            shift = _TWO_PI  # across the seam upward
+        elif b_hi[2] == PI_HI and a_lo[2] == -PI_HI and not (b_lo[2] <= a_hi[2] and a_lo[2] <= b_hi[2]):
+            shift = -_TWO_PI
+        offs[k + 1] = offs[k] + shift
+        b_lo_u = b_lo.copy()
+        b_hi_u = b_hi.copy()
+        b_lo_u[2] += offs[k + 1] - offs[k]
+        b_hi_u[2] += offs[k + 1] - offs[k]
+        # in a's frame: the shared piece is the intersection of the two closed boxes
+        p_lo = np.maximum(a_lo, b_lo_u)
+        p_hi = np.minimum(a_hi, b_hi_u)
+        p = 0.5 * (p_lo + p_hi)
+        p[2] += offs[k]
+        points.append(p)
+    return np.array(points).reshape(-1, 3), offs
+
+
+def _goal_turns(goal_phi: float, last_centre_phi: float) -> int:
+    return int(round((last_centre_phi - goal_phi) / _TWO_PI))
+
+
+def _shift_phi(box: np.ndarray, turns: int) -> np.ndarray:
+    """The enclosure box with phi + 2 pi turns, rounded outward."""
+    if turns == 0:
+        return box.copy()
+    two_pi = Interval(np.float64(2.0 * PI_LO), np.float64(2.0 * PI_HI))
+    s = Interval(np.float64(box[2, 0]), np.float64(box[2, 1])) + two_pi * float(turns)
+    out = box.copy()
+    out[2] = [float(s.lo), float(s.hi)]
+    return out
+
+
+# --------------------------------------------------------------------------------------
+# Smoothing
+# --------------------------------------------------------------------------------------
+def _smooth(geometry: Geometry, ends: list[np.ndarray], sign: int, quick: int,
+            leaves: "_LeafIndex", name: str) -> list[int]:
+    """Indices of the waypoints kept: from each kept one, jump to the farthest acceptable one.
+
+    A shortcut is acceptable when points sampled along it (steps below half the
+    finest leaf width) all lie in boxes certified INSIDE the aspect, so the path
+    keeps to the certified part of the paving (some clearance from det A = 0,
+    readable region sequences), AND the segment is certified (the proof).  The
+    farthest is searched by doubling the jump then bisecting, assuming (not
+    requiring) monotonicity; a failed guess only costs length.
+    """
+    paving = leaves.paving
+    inside = paving.labels[name] == Label.INSIDE
+    step = (paving.domain[:, 1] - paving.domain[:, 0]) / (1 << paving.depth) / 2
+    m = len(ends)
+    mids = [0.5 * (e[:, 0] + e[:, 1]) for e in ends]
+    lo_lim = np.array([float(v) for v in geometry.rho_min])
+    hi_lim = np.array([float(v) for v in geometry.rho_max])
+
+    def ok(i: int, j: int) -> bool:
+        # a float look first (a heuristic filter only: it never certifies anything)
+        n = int(np.ceil(np.max(np.abs(mids[j] - mids[i]) / step))) + 2
+        t = np.linspace(0.0, 1.0, n)[:, None]
+        pts = mids[i] + t * (mids[j] - mids[i])
+        leaf = leaves.lookup(pts)
+        if np.any(leaf < 0) or not np.all(inside[leaf]):
+            return False
+        if np.any(sign * approx_det_a(geometry, pts) <= 0):
+            return False
+        r = approx_inverse_kinematics(geometry, pts)
+        if np.any(r < lo_lim) or np.any(r > hi_lim):
+            return False
+        return certify_segment(geometry, ends[i], ends[j], sign, max_bisections=quick, max_pieces=4096).certified
+
+    kept = [0]
+    i = 0
+    while i < m - 1:
+        if ok(i, m - 1):
+            kept.append(m - 1)
+            break
+        good, step = i + 1, 1
+        bad = m - 1
+        while good + step < m - 1:
+            if ok(i, good + step):
+                good += step
+                step *= 2
+            else:
+                bad = good + step
+                break
+        while bad - good > 1:
+            mid = (good + bad) // 2
+            if ok(i, mid):
+                good = mid
+            else:
+                bad = mid
+        kept.append(good)
+        i = good
+    return kept
+
+
+# --------------------------------------------------------------------------------------
+# Regions and joint cells along the path
+# --------------------------------------------------------------------------------------
+class _LeafIndex:
+    """Finds the leaf of a paving that holds each point (sorted integer keys per level)."""
+
+    def __init__(self, paving: Paving):
+        self.paving = paving
+        d = paving.depth
+        self.nb = d + 1
+        self.levels = []
+        for L in range(d + 1):
+            sel = np.flatnonzero(paving.level == L)
+            if sel.size == 0:
+                continue
+            ijk = paving.ijk[sel]
+            keys = (ijk[:, 0] << (2 * self.nb)) | (ijk[:, 1] << self.nb) | ijk[:, 2]
+            order = np.argsort(keys)
+            self.levels.append((L, keys[order], sel[order]))
+
+    def lookup(self, points: np.ndarray) -> np.ndarray:
+        """Leaf index of each point (x, y, phi; phi any real, wrapped here), -1 outside the domain."""
+        p = self.paving
+        d = p.depth
+        n = 1 << d
+        pts = np.array(points, dtype=np.float64, copy=True).reshape(-1, 3)
+        pts[:, 2] = _wrap(pts[:, 2])
+        width = p.domain[:, 1] - p.domain[:, 0]
+        f = np.floor((pts - p.domain[:, 0]) / (width / n)).astype(np.int64)
+        ok = np.all((f >= 0) & (f < n), axis=1)
+        f = np.clip(f, 0, n - 1)
+        out = np.full(pts.shape[0], -1, dtype=np.int64)
+        for L, ks, idx in self.levels:
+            g = f >> (d - L)
+            q = (g[:, 0] << (2 * self.nb)) | (g[:, 1] << self.nb) | g[:, 2]
+            pos = np.minimum(np.searchsorted(ks, q), ks.size - 1)
+            hit = (ks[pos] == q) & ok & (out < 0)
+            out[hit] = idx[pos[hit]]
+        return out
+
+
+def _samples(waypoints: np.ndarray, step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points along each segment with every coordinate step below ``step``; segment index of each."""
+    pts, seg = [], []
+    for k in range(len(waypoints) - 1):
+        a, b = waypoints[k], waypoints[k + 1]
+        n = int(np.ceil(np.max(np.abs(b - a) / step))) + 1
+        t = np.linspace(0.0, 1.0, max(n, 2) + 1)
+        if k < len(waypoints) - 2:
+            t = t[:-1]
+        pts.append(a + t[:, None] * (b - a))
+        seg.append(np.full(t.size, k))
+    return np.concatenate(pts), np.concatenate(seg)
+
+
+def _dedupe(seq) -> list:
+    out: list = []
+    for s in seq:
+        if not out or out[-1] != s:
+            out.append(s)
+    return out
+
+
+_TWO_PI = 2.0 * math.pi
