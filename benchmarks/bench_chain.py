@@ -22,15 +22,13 @@ import time
 
 
 def one(depth: int, geometry_path: str | None) -> dict:
-    from intervalkin.app.progress import Stages
-    from intervalkin.pipeline import analyse
-    from intervalkin.app.summary import chain_summary
     from intervalkin.app.options import geometry_from_option
+    from intervalkin.app.summary import chain_summary
+    from intervalkin.pipeline import analyse
 
     g = geometry_from_option(geometry_path)
-    st = Stages(quiet=True)
     t0 = time.perf_counter()
-    a = analyse(g, depth, st)
+    a = analyse(g, depth)
     total = time.perf_counter() - t0
     s = chain_summary(a)
     return {

@@ -43,3 +43,10 @@ def small_chain(geometry, workspace_depth: int, joint_depth: int, regions_depth:
     if regions_depth is None:
         return jp
     return jp, analyse_regions(geometry, jp, regions_depth)
+
+
+@pytest.fixture(scope="session")
+def regions_chain(paper_geometry):
+    """The chain shared by test_regions and test_regions_properties (built once, about 8 s):
+    workspace depth 7, joint grid 2**6, regions at depth 7."""
+    return small_chain(paper_geometry, 7, 6, 7, max_solves=200)

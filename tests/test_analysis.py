@@ -26,9 +26,11 @@ def analysed(tmp_path_factory):
 def test_outputs_and_summary_schema(analysed):
     s = json.loads((analysed / "summary.json").read_text())
     assert s["aspects"]["count"] == 2 and s["aspects"]["lower_bound"] == 2
-    for key in ("basic_regions", "uniqueness_domains"):
-        assert {"count", "exact", "lower_bound"} <= set(s[key])
-        assert s[key]["lower_bound"] <= max(s[key]["count"], s[key]["lower_bound"])
+    for key in ("aspects", "basic_regions", "uniqueness_domains"):
+        assert {"count", "exact", "lower_bound", "upper_bound", "why"} <= set(s[key])
+        # a count never falls below its certified lower bound; none is exact without an upper bound
+        assert 0 <= s[key]["lower_bound"] <= s[key]["count"]
+        assert s[key]["exact"] is False and s[key]["upper_bound"] is None
     with np.load(analysed / "pavings" / "workspace.npz") as z:
         assert {"lo", "hi", "depth", "in_workspace", "det_sign", "aspect", "basic_region", "uniqueness_domain"} <= set(z.files)
         n = z["lo"].shape[0]
@@ -62,8 +64,9 @@ def test_refuses_a_foreign_non_empty_folder(tmp_path, capsys):
 @pytest.mark.parametrize(
     "argv,fragment",
     [
-        (["analyze", "--depth", "0"], "--depth"),
-        (["analyze", "--depth", "40"], "--depth"),
+        (["analyze", "--depth", "0"], "depth: expected an integer in 3..9, got 0"),
+        (["analyze", "--depth", "40"], "depth: expected an integer in 3..9, got 40"),
+        (["analyze", "--depth", "5", "--refine-to", "4"], "refine_to: expected an integer in 5..9, got 4"),
         (["analyze", "--geometry", "/nonexistent.toml"], "not found"),
         (["joint", "--depth", "12"], "--depth"),
         (["label", "1", "2", "x", "--from", "/nonexistent"], "pose"),
@@ -73,6 +76,7 @@ def test_bad_input_one_line_status_2(tmp_path, capsys, argv, fragment):
     assert main(argv + ["--out", str(tmp_path / "o")] if argv[0] != "label" else argv) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and fragment in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()  # refused before the output folder is made
 
 
 def test_unwritable_out(tmp_path, capsys):
@@ -108,13 +112,40 @@ def test_interrupted_run_leaves_no_partial_file(tmp_path):
 
 
 def test_label_from_an_earlier_output(analysed, capsys):
-    assert main(["label", "-5.495660815453", "-13.935498276039", "-0.047331369367", "--from", str(analysed),
-                 "--json"]) == 0
+    """``label --from`` reads the npz; it answers as the in-memory analysis of the same run does."""
+    with np.load(analysed / "pavings" / "workspace.npz") as z:
+        lo, hi, region, domain = z["lo"], z["hi"], z["basic_region"], z["uniqueness_domain"]
+    i = int(np.flatnonzero(region >= 0)[0])
+    centre = [repr(float(v)) for v in 0.5 * (lo[i] + hi[i])]
+    assert main(["label", *centre, "--from", str(analysed), "--json"]) == 0
     res = json.loads(capsys.readouterr().out)
-    assert res["in_workspace"] in ("yes", "undecided")
-    assert res["aspect"] in ("WA1", "undecided")
+    assert res["pose"] == centre and res["in_workspace"] == "yes" and res["aspect"] in ("WA1", "WA2")
+    assert res["basic_region"] == int(region[i]) and res["uniqueness_domain"] == int(domain[i])
+    assert "note" not in res
+    # certified outside W: B1 on the base point A1 puts leg 1 at length 0
+    assert main(["label", "0", "0", "0", "--from", str(analysed), "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["in_workspace"] == "no" and res["aspect"] == res["basic_region"] == "none (outside W)"
+    # outside the paved domain: no box holds the pose
     assert main(["label", "60", "60", "0", "--from", str(analysed), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["boxes"] == 0
+
+
+def test_label_from_npz_matches_the_analysis(analysed):
+    """The npz lookup and the in-memory lookup agree pose by pose (same depth, same seed)."""
+    from intervalkin.app.label import label_from_npz
+    from intervalkin.pipeline import analyse
+
+    a = analyse(None, 5)
+    with np.load(analysed / "pavings" / "workspace.npz") as z:
+        lo, hi = z["lo"], z["hi"]
+    rng = np.random.default_rng(5)
+    picks = rng.choice(len(lo), size=40, replace=False)
+    poses = [[repr(float(v)) for v in lo[i] + rng.random(3) * (hi[i] - lo[i])] for i in picks]
+    # a shared face: the lower corner of a box lies in every box around it
+    poses.append([repr(float(v)) for v in lo[picks[0]]])
+    for pose in poses:
+        assert label_from_npz(analysed, pose) == a.label(pose)
 
 
 def test_joint_command(tmp_path, capsys):
@@ -125,15 +156,15 @@ def test_joint_command(tmp_path, capsys):
     assert "count" in capsys.readouterr().out
 
 
-def test_refinement_deepens_until_consistent_or_limit(tmp_path):
+def test_refinement_deepens_until_consistent_or_limit():
+    from intervalkin.core.errors import InputError
     from intervalkin.pipeline import analyse
-    from intervalkin.core.geometry import default_geometry
 
-    a = analyse(default_geometry(), 5, refine_to=6)
+    a = analyse(None, 5, refine_to=6)
     h = list(a.refinement)
-    assert h[0]["depth"] == 5 and 1 <= len(h) <= 2
-    assert h[-1]["consistent"] or h[-1]["depth"] == 6
-    assert a.depth == h[-1]["depth"] == a.regions.paving.depth
-    assert "stopped" in h[-1]
-    with pytest.raises(Exception, match="--refine-to"):
-        analyse(default_geometry(), 5, refine_to=4)
+    assert h[0].depth == 5 and 1 <= len(h) <= 2
+    assert h[-1].consistent or h[-1].depth == 6
+    assert a.depth == h[-1].depth == a.regions.paving.depth
+    assert h[-1].stopped and not any(step.stopped for step in h[:-1])
+    with pytest.raises(InputError, match=r"^refine_to: expected an integer in 5\.\.9, got 4$"):
+        analyse(None, 5, refine_to=4)

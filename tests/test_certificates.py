@@ -14,12 +14,12 @@ import pytest
 from flint import ctx
 
 from intervalkin import checker
-from intervalkin.checker.model import _Model
-from intervalkin.checker.parse import _Refused
-from intervalkin.checker.parse import _q
-from intervalkin.checker.solutions import _count_solutions
-from intervalkin.checker.solutions import _disjoint_mod_2pi
-from intervalkin.checker.solutions import _reduced_sextic
+from intervalkin.checker.model import ArbModel as _Model
+from intervalkin.checker.parse import Refused as _Refused
+from intervalkin.checker.model import exact_ball as _q
+from intervalkin.checker.solutions import count_solutions as _count_solutions
+from intervalkin.checker.solutions import disjoint_mod_2pi as _disjoint_mod_2pi
+from intervalkin.checker.solutions import reduced_sextic as _reduced_sextic
 from intervalkin.certify.writer import write_certificates
 from intervalkin.app.cli import main
 from intervalkin.kinematics.sextic import _poly_t, _reduce
@@ -104,7 +104,7 @@ def test_every_claim_of_the_chain_verifies(cert_dir, capsys):
 def test_counts_are_backed_by_the_claims(cert_dir, chain):
     _, ra = chain
     declared = {c["name"]: c for c in _load(cert_dir, "counts.json")["claims"]}
-    counts = ra.counts()
+    counts = ra.counts().to_json()
     for name in ("aspects", "basic_regions", "uniqueness_domains"):
         assert declared[name]["lower_bound"] == counts[name]["lower_bound"]
         assert declared[name]["exact"] is False and declared[name]["support"]
@@ -208,7 +208,9 @@ def test_disjointness_reads_phi_modulo_two_pi():
 
 
 def test_box_label_refused_when_false(paper_geometry, cert_dir):
-    """A box straddling det A = 0 cannot be re-proved with either sign."""
+    """box_label_proved re-proves true labels and refuses false ones: a paving box of a region claim is
+    proved inside W and not outside it; a box around A1 (rho_1 < 10) is proved outside W and not inside;
+    BOUNDARY claims nothing (None).  Would catch a checker that proves whatever label it is given."""
     doc = _load(cert_dir, "region_distinct.json")
     b = doc["claims"][0]["solutions"][0]["paving_box"]["box"]
     assert checker.box_label_proved(paper_geometry, b, "W", 2)

@@ -202,9 +202,19 @@ def test_pose_round_trip(paper_geometry, rng):
 
 
 def test_solutions_sorted_and_unique_boxes_disjoint(paper_geometry):
+    """Table 1's six boxes are listed by increasing phi and are pairwise disjoint, phi read modulo 2 pi
+    (checked here directly on the bounds, not with the solver's own disjointness test)."""
     result = solve(paper_geometry, parse_joint_vector(paper_geometry, ["14.98", "15.38", "12.0"]))
     phis = [s.midpoint[2] for s in result.solutions]
     assert phis == sorted(phis)
+    boxes = [np.asarray(s.box) for s in result.solutions]
+    for a in range(len(boxes)):
+        for b in range(a + 1, len(boxes)):
+            A, B = boxes[a], boxes[b]
+            apart_xy = any(A[j, 1] < B[j, 0] or B[j, 1] < A[j, 0] for j in (0, 1))
+            apart_phi = all(A[2, 1] < B[2, 0] + k * 2 * math.pi or B[2, 1] + k * 2 * math.pi < A[2, 0]
+                            for k in (-1, 0, 1))
+            assert apart_xy or apart_phi, (a, b)
     assert result.precision == 64
     assert "isolated" in result.completeness_reason
 
@@ -472,7 +482,7 @@ def test_cli_dkp_bad_geometry(capsys, tmp_path):
 
 
 def test_box_separation_reads_phi_modulo_two_pi():
-    from intervalkin.solve.krawczyk import _disjoint
+    from intervalkin.solve.krawczyk import disjoint_mod_2pi as _disjoint
 
     def box(x, y, phi, r=1e-12):
         return np.array([[x - r, x + r], [y - r, y + r], [phi - r, phi + r]])

@@ -84,10 +84,14 @@ def test_coordinates_platform_equals_side_lengths(tmp_path):
     assert abs(float(g.p3x) - float(g2.p3x)) < 1e-12 and abs(float(g.p3y) - float(g2.p3y)) < 1e-12
 
 
-def test_shipped_example_files_load():
-    for name in ("offset_right.toml", "coords_platform.toml"):
+def test_shipped_example_files_load(tmp_path, paper_geometry):
+    """The example geometries load, differ from the paper's, and survive a to_toml round trip exactly."""
+    seen = []
+    for name in ("offset_right.toml", "coords_platform.toml", "concurrent_legs.toml"):
         g = load_geometry(DATA / name)
-        assert g.name
+        assert g.name and g != paper_geometry and g not in seen
+        assert load_geometry(_write(tmp_path, g.to_toml())) == g
+        seen.append(g)
 
 
 def test_to_toml_round_trips(tmp_path, paper_geometry):

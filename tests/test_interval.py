@@ -168,11 +168,20 @@ def test_intersect_of_disjoint_enclosures_is_refused():
 
 
 def test_round_to_nearest_would_fail():
-    """The suite can catch a missing outward rounding: 0.1 + 0.2 in floats is not an enclosure."""
-    exact = arb("0.1") + arb("0.2")
-    lo, hi = arb_to_bounds(arb("0.1"))
-    lo2, hi2 = arb_to_bounds(arb("0.2"))
-    s = Interval.from_bounds(lo, hi) + Interval.from_bounds(lo2, hi2)
+    """The suite can catch a missing outward rounding: 0.1 + 0.2 in floats is not an enclosure.
+
+    The operands are the floats 0.1 and 0.2 themselves (exact reals, not widened decimals),
+    so Interval.__add__ without outward rounding returns [fl(0.1 + 0.2)] and fails here.
+    """
+    exact = arb(0.1) + arb(0.2)  # floats are exact in arb; the sum is exact at 256 bits
+    s = Interval.point(0.1) + Interval.point(0.2)
     assert _contains(s, exact)
     naive = Interval.point(0.1 + 0.2)
     assert not _contains(naive, exact)
+
+
+def test_product_rounding_would_fail():
+    """Same for a product: fl(0.1 * 3) lies above the exact product of the floats 0.1 and 3."""
+    exact = arb(0.1) * 3
+    assert _contains(Interval.point(0.1) * 3.0, exact)
+    assert not _contains(Interval.point(0.1 * 3.0), exact)

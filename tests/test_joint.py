@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from decimal import Decimal
 from fractions import Fraction
 
 import numpy as np
@@ -10,9 +11,27 @@ from flint import arb, ctx
 
 from intervalkin.kinematics.formulas import approx_det_a, det_a_arb, inverse_kinematics_arb
 from intervalkin.solve.dkp import solve
-from intervalkin.space.joint_space import _mark, _range_sum, _summed_area, joint_paving, solution_count
+from intervalkin.solve.dkp import parse_joint_vector
+from intervalkin.space.joint_space import _mark, _range_sum, _summed_area, joint_paving
 
 from .conftest import small_chain
+
+
+def solution_count(geometry, rho, paving):
+    """(count, n_wa1, n_wa2, source): from the cell of q when it is solved, else from a certified solve.
+
+    Moved here from ``intervalkin.space.joint_space`` (only this test used it; the
+    library's answer is ``Analysis.locate``).
+    """
+    q = parse_joint_vector(geometry, rho)
+    cid = paving.cell_at(q)
+    if cid >= 0 and paving.cells[cid].count >= 0:
+        c = paving.cells[cid]
+        return c.count, c.n_wa1, c.n_wa2, f"cell {cid}"
+    res = solve(geometry, q)
+    assert res.complete and all(s.status == "unique" for s in res.solutions)
+    n1 = sum(1 for s in res.solutions if s.det_sign > 0)
+    return len(res.solutions), n1, len(res.solutions) - n1, "solve"
 
 
 @pytest.fixture(scope="module")
@@ -51,12 +70,21 @@ def test_solutions_split_equally_between_aspects(joint):
 
 
 def test_paper_joint_vector_is_in_a_six_solution_cell(joint, paper_geometry):
+    """solution_count answers Table 1's q with 6 = 3 + 3, from its cell when it has one, else by a solve;
+    and a cell's own witness is answered from the cell, with the cell's count.
+
+    Would catch a lookup that answers from the wrong cell, or never from a cell at all.
+    """
     q = [Fraction("14.98"), Fraction("15.38"), Fraction("12.0")]
     count, n1, n2, source = solution_count(paper_geometry, ["14.98", "15.38", "12.0"], joint)
     assert (count, n1, n2) == (6, 3, 3)
     cid = joint.cell_at(q)
-    if cid >= 0:
-        assert source == f"cell {cid}"
+    assert source == (f"cell {cid}" if cid >= 0 and joint.cells[cid].count >= 0 else "solve")
+    for c in [c for c in joint.cells if c.count >= 0][:5]:
+        # the witnesses have power-of-two denominators: exact as decimals
+        text = [str(Decimal(v.numerator) / Decimal(v.denominator)) for v in c.witness]
+        assert [Fraction(t) for t in text] == list(c.witness)
+        assert solution_count(paper_geometry, text, joint) == (c.count, c.n_wa1, c.n_wa2, f"cell {c.id}")
 
 
 def _certified_singular_point(g, rng):

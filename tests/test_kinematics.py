@@ -2,16 +2,37 @@
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
 from flint import arb, arb_mat, ctx
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from intervalkin.core.errors import InputError
+from intervalkin.core.geometry import default_geometry, load_geometry
+from intervalkin.core.interval import Interval
 from intervalkin.kinematics.constants import constants
-from intervalkin.kinematics.enclosures import _IntervalOps, _box_intervals, det_a_interval, rho_sq_interval
-from intervalkin.kinematics.formulas import _det_formula, approx_det_a, approx_inverse_kinematics, approx_jacobian, det_a_arb, inverse_kinematics_arb, jacobian_arb, rho_sq_arb
-from intervalkin.core.geometry import load_geometry
+from intervalkin.kinematics.enclosures import (
+    det_a_gradient_interval,
+    det_a_interval,
+    jacobian_interval,
+    rho_interval,
+    rho_sq_interval,
+)
+from intervalkin.kinematics.formulas import (
+    approx_det_a,
+    approx_rho_sq,
+    approx_inverse_kinematics,
+    approx_jacobian,
+    det_a_arb,
+    det_coefficients,
+    inverse_kinematics_arb,
+    jacobian_arb,
+    quadratic,
+    rho_sq_arb,
+)
 
 from .conftest import DATA
 
@@ -51,7 +72,7 @@ def test_interval_forms_enclose_arb_values(paper_geometry, geometry_file):
             exact_r = rho_sq_arb(g, x, y, phi)
             exact_d = det_a_arb(g, x, y, phi)
             for i in range(3):
-                assert not (exact_r[i] < arb(float(rho2[i].lo[k])) or exact_r[i] > arb(float(rho2[i].hi[k])))
+                assert not (exact_r[i] < arb(float(rho2.lo[k, i])) or exact_r[i] > arb(float(rho2.hi[k, i])))
             assert not (exact_d < arb(float(det.lo[k])) or exact_d > arb(float(det.hi[k])))
 
 
@@ -63,8 +84,6 @@ def test_interval_forms_enclose_arb_values(paper_geometry, geometry_file):
     st.floats(1e-12, 1.0),
 )
 def test_thin_boxes_enclose(x, y, phi, w):
-    from intervalkin.core.geometry import default_geometry
-
     g = default_geometry()
     box = np.array([[[x, x + w], [y, y + w / 2], [phi, phi + w / 8]]])
     det = det_a_interval(g, box)
@@ -73,7 +92,7 @@ def test_thin_boxes_enclose(x, y, phi, w):
     r = rho_sq_interval(g, box)
     ex = rho_sq_arb(g, arb(x + w), arb(y + w / 2), arb(phi + w / 8))
     for i in range(3):
-        assert not (ex[i] < arb(float(r[i].lo[0])) or ex[i] > arb(float(r[i].hi[0])))
+        assert not (ex[i] < arb(float(r.lo[0, i])) or ex[i] > arb(float(r.hi[0, i])))
 
 
 def test_det_formula_equals_determinant_of_jacobian(paper_geometry):
@@ -116,12 +135,119 @@ def test_paper_solutions_2_3_6_have_positive_det(paper_geometry):
     assert list(signs) == [-1, 1, 1, -1, -1, 1]
 
 
+def _natural_det(geometry, boxes):
+    """det A by the natural interval extension of the same formula (each occurrence of x, y, phi independent)."""
+    k = constants(geometry)
+    x, y, phi = (Interval(boxes[:, j, 0], boxes[:, j, 1]) for j in range(3))
+    r = [(k.radius_iv[i] * (phi + k.alpha_iv[i]).cos(), k.radius_iv[i] * (phi + k.alpha_iv[i]).sin()) for i in (1, 2)]
+    e = [(k.ax_iv[i] - k.ax_iv[0], k.ay_iv[i] - k.ay_iv[0]) for i in (1, 2)]
+    coef = det_coefficients(*r[0], *r[1], *e[0], *e[1])
+    return quadratic(coef, x - k.ax_iv[0], y - k.ay_iv[0]) * 8.0
+
+
 def test_centred_form_sharpens_small_boxes(paper_geometry):
     rng = np.random.default_rng(9)
     boxes = _random_boxes(rng, 500, [2.0**-8])
     det = det_a_interval(paper_geometry, boxes)
-    # the natural form alone, for comparison
-    x, y, phi = _box_intervals(boxes)
-    natural = _det_formula(_IntervalOps, constants(paper_geometry), x, y, phi) * 8.0
+    natural = _natural_det(paper_geometry, boxes)
     assert np.all(det.hi - det.lo <= natural.hi - natural.lo)
     assert np.median((det.hi - det.lo) / (natural.hi - natural.lo)) < 0.9
+
+
+def test_phi_tight_det_is_sharper_than_natural_form(paper_geometry):
+    """On the leaves of a depth-6 paving the phi-tight form beats the natural form of the same formula."""
+    from intervalkin.paving.predicates import pave_workspace
+
+    p = pave_workspace(paper_geometry, 6)
+    b = p.boxes[p.level == p.depth][:5000]
+    old = _natural_det(paper_geometry, b)
+    new = det_a_interval(paper_geometry, b)
+    assert np.median(new.hi - new.lo) < np.median(old.hi - old.lo)
+    # the two sound enclosures of one quantity always intersect
+    assert np.all(np.maximum(old.lo, new.lo) <= np.minimum(old.hi, new.hi))
+
+
+def _arb_hull(lo: float, hi: float):
+    return arb(float(lo)).union(arb(float(hi)))
+
+
+def _mixed_boxes(rng, n):
+    """Boxes of many sizes, some thin, some across phi = +-pi (unwrapped)."""
+    boxes = _random_boxes(rng, n, [2.0**-2, 2.0**-5, 2.0**-9, 2.0**-16, 0.0])
+    thin = rng.uniform(size=(n, 3)) < 0.2
+    boxes[..., 1] = np.where(thin, boxes[..., 0], boxes[..., 1])
+    seam = rng.uniform(size=n) < 0.2
+    boxes[seam, 2] = np.pi + np.sort(rng.uniform(-0.05, 0.05, (int(seam.sum()), 2)), axis=1)
+    return boxes
+
+
+@pytest.mark.parametrize("geometry_file", [None, "coords_platform.toml"])
+def test_jacobian_interval_encloses_arb(paper_geometry, geometry_file):
+    """Every entry of A at sampled points (corners included) lies in the enclosure over the box."""
+    g = paper_geometry if geometry_file is None else load_geometry(DATA / geometry_file)
+    rng = np.random.default_rng(21)
+    boxes = _mixed_boxes(rng, 200)
+    J = jacobian_interval(g, boxes)
+    assert J.lo.shape == (200, 3, 3)
+    for p in _points_in(rng, boxes, 2):
+        for k in range(len(boxes)):
+            A = jacobian_arb(g, *(arb(float(v)) for v in p[k]))
+            for i in range(3):
+                for j in range(3):
+                    assert not (A[i][j] < arb(float(J.lo[k, i, j])) or A[i][j] > arb(float(J.hi[k, i, j])))
+
+
+def test_jacobian_is_the_gradient_of_rho_sq(paper_geometry):
+    """Row i of A is grad rho_i^2: central differences of the float rho_i^2 agree with approx_jacobian."""
+    rng = np.random.default_rng(8)
+    X = np.column_stack([rng.uniform(-20, 20, 50), rng.uniform(-20, 20, 50), rng.uniform(-3, 3, 50)])
+    h = 1e-6
+    fd = np.stack([(approx_rho_sq(paper_geometry, X + h * e) - approx_rho_sq(paper_geometry, X - h * e)) / (2 * h)
+                   for e in np.eye(3)], axis=-1)
+    assert np.allclose(fd, approx_jacobian(paper_geometry, X), rtol=1e-6, atol=1e-5)
+
+
+def test_det_gradient_satisfies_the_mean_value_theorem(paper_geometry):
+    """det A(q) - det A(p) lies in grad det A(box) . (q - p) for points p, q of the box (arb)."""
+    rng = np.random.default_rng(12)
+    boxes = _mixed_boxes(rng, 150)
+    G = det_a_gradient_interval(paper_geometry, boxes)
+    pts = _points_in(rng, boxes, 2)
+    for k in range(len(boxes)):
+        for p, q in ((pts[0][k], pts[1][k]), (pts[2][k], pts[3][k]), (pts[1][k], pts[3][k])):
+            ap, aq = [arb(float(v)) for v in p], [arb(float(v)) for v in q]
+            diff = det_a_arb(paper_geometry, *aq) - det_a_arb(paper_geometry, *ap)
+            bound = sum(_arb_hull(G.lo[k, j], G.hi[k, j]) * (aq[j] - ap[j]) for j in range(3))
+            assert diff.overlaps(bound), (k, diff, bound)
+
+
+def test_rho_interval_is_the_root_of_rho_sq(paper_geometry):
+    rng = np.random.default_rng(2)
+    boxes = _mixed_boxes(rng, 100)
+    r, r2 = rho_interval(paper_geometry, boxes), rho_sq_interval(paper_geometry, boxes)
+    assert r.lo.shape == r2.lo.shape == (100, 3)
+    assert np.all(r.lo <= np.sqrt(np.maximum(r2.lo, 0.0))) and np.all(r.hi >= np.sqrt(r2.hi))
+
+
+def test_empty_and_malformed_box_arrays(paper_geometry):
+    empty = np.zeros((0, 3, 2))
+    assert rho_sq_interval(paper_geometry, empty).lo.shape == (0, 3)
+    assert det_a_interval(paper_geometry, empty).lo.shape == (0,)
+    assert jacobian_interval(paper_geometry, empty).lo.shape == (0, 3, 3)
+    with pytest.raises(InputError, match="boxes"):
+        det_a_interval(paper_geometry, np.zeros((4, 3)))
+
+
+def test_constants_are_cached_by_identity(paper_geometry):
+    k = constants(paper_geometry)
+    assert constants(paper_geometry) is k
+    other = load_geometry(DATA / "offset_right.toml")
+    assert constants(other) is not k and constants(other).geometry is other
+    # the interval constants enclose the exact ones (arb at 200 bits)
+    for i in range(3):
+        px, py = paper_geometry.platform_point(i)
+        radius = (px.arb() ** 2 + py.arb() ** 2).sqrt()
+        assert arb(float(k.radius_iv.lo[i])) <= radius <= arb(float(k.radius_iv.hi[i]))
+        lo, hi = k.rho_min_sq_iv.lo[i], k.rho_min_sq_iv.hi[i]
+        v = paper_geometry.rho_min[i] ** 2
+        assert Fraction(lo) <= v <= Fraction(hi)

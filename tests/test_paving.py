@@ -40,12 +40,33 @@ def _random_octree(rng, depth, p_split=0.5, seam_split=True):
 
 
 def test_label_algebra():
+    """and_labels is the three-valued conjunction, not_label the negation (full truth tables)."""
     a = np.array([1, 1, 1, 2, 2, 2, 3, 3, 3], np.uint8)
     b = np.array([1, 2, 3, 1, 2, 3, 1, 2, 3], np.uint8)
     assert and_labels(a, b).tolist() == [1, 1, 1, 1, 2, 3, 1, 3, 3]
     assert not_label(np.array([1, 2, 3], np.uint8)).tolist() == [2, 1, 3]
-    # intersection of two sound labels of one predicate: bitwise and
-    assert (np.uint8(Label.INSIDE) & np.uint8(Label.BOUNDARY)) == Label.INSIDE
+
+
+def test_label_flags_intersect_as_sets_of_possible_answers():
+    """The encoding the paver relies on (``sharp = inherited & new``): a label is the bit set of the
+    answers still possible (OUTSIDE = {fails}, INSIDE = {holds}, BOUNDARY = both), so ``&`` of two sound
+    labels of ONE predicate is their intersection, and only INSIDE & OUTSIDE gives CONTRADICTION (0).
+
+    Would catch: a renumbering of Label (e.g. BOUNDARY = 0, or INSIDE = 1 and OUTSIDE = 2 with
+    BOUNDARY = 4) under which ``&`` would silently drop a decided label or never flag a contradiction.
+    """
+    possible = {Label.OUTSIDE: {"fails"}, Label.INSIDE: {"holds"}, Label.BOUNDARY: {"fails", "holds"}}
+    for a, sa in possible.items():
+        for b, sb in possible.items():
+            got = Label(int(a) & int(b))
+            if sa & sb:
+                assert possible[got] == sa & sb, (a, b, got)
+            else:
+                assert got == Label.CONTRADICTION, (a, b, got)
+    # not_label maps each set of possible answers to the set of their negations
+    flip = {"fails": "holds", "holds": "fails"}
+    for a, sa in possible.items():
+        assert possible[Label(int(not_label(np.array([a], np.uint8))[0]))] == {flip[v] for v in sa}
 
 
 def test_leaves_tile_the_domain(paving5):
@@ -99,9 +120,17 @@ def test_children_cover_parent_and_labels_sharpen():
 
 
 def test_pave_splits_only_undecided():
+    """The paver splits a box exactly when its label is BOUNDARY, down to the depth, and keeps the labels.
+
+    Checked leaf by leaf against the predicate itself: each leaf carries the label of its own box; each
+    leaf below the root has a parent whose box is undecided (so a decided box is never split); an
+    undecided leaf sits at the full depth (so no undecided box is left unsplit above it); decided
+    leaves above the full depth exist (the previous check is not vacuous).  Would catch a paver that
+    splits every box, stops early, splits decided boxes, or mixes up the labels of siblings.
+    """
     dom = np.array([[0.0, 1.0], [0.0, 1.0], [0.0, 1.0]])
 
-    def ball(boxes):  # x^2 + y^2 + z^2 <= 0.5 with exact interval bounds of a monotone function
+    def ball(boxes):  # x^2 + y^2 + z^2 <= 0.5, from the bounds of a function monotone on [0, 1]^3
         lo2 = np.sum(np.where(boxes[..., 0] > 0, boxes[..., 0] ** 2, 0.0), axis=1)
         hi2 = np.sum(boxes[..., 1] ** 2, axis=1)
         lab = np.full(len(boxes), Label.BOUNDARY, np.uint8)
@@ -109,10 +138,16 @@ def test_pave_splits_only_undecided():
         lab[lo2 > 0.5001] = Label.OUTSIDE
         return lab
 
-    p = pave(dom, ball, 5, name="ball")
+    depth = 5
+    p = pave(dom, ball, depth, name="ball")
     lab = p.labels["ball"]
-    assert np.all(p.level[lab != Label.BOUNDARY] <= 5)
-    assert np.all(p.level[lab == Label.BOUNDARY] == 5)
+    assert np.array_equal(lab, ball(p.boxes))
+    assert np.all(p.level[lab == Label.BOUNDARY] == depth)
+    decided_early = (lab != Label.BOUNDARY) & (p.level < depth)
+    assert decided_early.sum() > 20 and {Label.INSIDE, Label.OUTSIDE} <= set(lab[decided_early].tolist())
+    below_root = p.level > 0
+    plo, phi_ = box_bounds(dom, p.level[below_root].astype(np.int64) - 1, p.ijk[below_root] // 2)
+    assert np.all(ball(np.stack([plo, phi_], axis=-1)) == Label.BOUNDARY)
     ev = [s["evaluated"]["ball"] for s in p.stats]
     splits = [s["split"] for s in p.stats]
     assert all(ev[i + 1] == 8 * splits[i] for i in range(len(ev) - 1))

@@ -13,13 +13,12 @@ from flint import arb, ctx, fmpq
 from hypothesis import given, settings, strategies as st
 
 from intervalkin.core.geometry import default_geometry
+from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_interval
 from intervalkin.kinematics.formulas import det_a_arb, rho_sq_arb
-from intervalkin.kinematics.enclosures import det_a_interval
 from intervalkin.paving.labels import Label
 from intervalkin.paving.adjacency import shares_face
 from intervalkin.space.aspect import aspect_components
 from intervalkin.paving.predicates import aspect_labels, aspect_predicate, det_sign_labels, pave_workspace, workspace_labels
-from intervalkin.kinematics.quadratic import det_a_tight, rho_sq_tight
 
 GEOM = default_geometry()
 RMIN2 = [arb(fmpq(v.numerator, v.denominator)) ** 2 for v in GEOM.rho_min]
@@ -93,10 +92,11 @@ def test_enclosures_contain_arb_values(paving6, pick, fr):
     pt = _point(box[0], fr)
     x, y, phi = _arb_at(pt)
     rs, det = _arb_values(x, y, phi)
-    d = det_a_tight(GEOM, box)
+    d = det_a_interval(GEOM, box)
     assert arb(d.lo[0]) <= det and det <= arb(d.hi[0]), (d.lo[0], det, d.hi[0])
-    for r, e in zip(rs, rho_sq_tight(GEOM, box)):
-        assert arb(e.lo[0]) <= r and r <= arb(e.hi[0])
+    e = rho_sq_interval(GEOM, box)
+    for i, r in enumerate(rs):
+        assert arb(e.lo[0, i]) <= r and r <= arb(e.hi[0, i])
 
 
 @settings(max_examples=60, deadline=None, derandomize=True)
@@ -107,8 +107,8 @@ def test_enclosures_on_random_boxes(seed, scale):
     c = rng.uniform([-32, -32, -np.pi], [32, 32, np.pi], (4, 3))
     h = rng.uniform(0, 1, (4, 3)) * scale * np.array([1, 1, 0.2])
     boxes = np.stack([c - h, c + h], -1)
-    d = det_a_tight(GEOM, boxes)
-    rs = rho_sq_tight(GEOM, boxes)
+    d = det_a_interval(GEOM, boxes)
+    rs = rho_sq_interval(GEOM, boxes)
     old = ctx.prec
     ctx.prec = 128
     try:
@@ -117,20 +117,10 @@ def test_enclosures_on_random_boxes(seed, scale):
                 x, y, phi = _arb_at(_point(boxes[k], fr))
                 det = det_a_arb(GEOM, x, y, phi)
                 assert arb(d.lo[k]) <= det and det <= arb(d.hi[k])
-                for r, e in zip(rho_sq_arb(GEOM, x, y, phi), rs):
-                    assert arb(e.lo[k]) <= r and r <= arb(e.hi[k])
+                for i, r in enumerate(rho_sq_arb(GEOM, x, y, phi)):
+                    assert arb(rs.lo[k, i]) <= r and r <= arb(rs.hi[k, i])
     finally:
         ctx.prec = old
-
-
-def test_tight_det_is_sharper_than_kinematics(paving6):
-    p, _, _, _ = paving6
-    b = p.boxes[p.level == p.depth][:5000]
-    old = det_a_interval(GEOM, b)
-    new = det_a_tight(GEOM, b)
-    assert np.median(new.hi - new.lo) < np.median(old.hi - old.lo)
-    # the two sound enclosures of one quantity always intersect
-    assert np.all(np.maximum(old.lo, new.lo) <= np.minimum(old.hi, new.hi))
 
 
 def test_aspects_compose_by_and_rule(paving6):

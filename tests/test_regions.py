@@ -10,18 +10,16 @@ import pytest
 from flint import arb, ctx
 
 from intervalkin.kinematics.formulas import det_a_arb, inverse_kinematics_arb
-from intervalkin.solve.continuation import _newton, compare_mod_2pi, krawczyk_segment, new_tracks, track
 from intervalkin.solve.dkp import solve
 from intervalkin.paving.labels import Label
 from intervalkin.space.basic_region import label_pose
 from intervalkin.space.uniqueness_domain import uniqueness_domains
 
-from .conftest import small_chain
 
 
 @pytest.fixture(scope="module")
-def chain(paper_geometry):
-    return small_chain(paper_geometry, 7, 6, 7, max_solves=200)
+def chain(regions_chain):
+    return regions_chain
 
 
 def test_region_boxes_hold_their_labels_in_arb(chain, paper_geometry):
@@ -88,19 +86,16 @@ def test_solutions_of_random_joint_vectors_are_separated(chain, paper_geometry):
         res = solve(paper_geometry, q)
         assert res.complete
         regions, domains = [], []
-        for s in res.solutions:
-            box = np.asarray(s.box)
-            inside = np.flatnonzero(np.all((p.lo <= box[:, 0]) & (box[:, 1] <= p.hi), axis=1))
-            reg = {int(ra.region[i]) for i in inside if ra.region[i] >= 0}
-            dom = {int(ra.domain[i]) for i in inside if ra.domain[i] >= 0}
-            if reg:
-                assert len(reg) == 1
-                r = ra.regions[reg.pop()]
+        # the leaf holding each solution box, or -1 (test_paving checks this lookup against brute force)
+        holders = p.locate_boxes(np.array([s.box for s in res.solutions]))
+        for s, i in zip(res.solutions, holders):
+            if i >= 0 and ra.region[i] >= 0:
+                r = ra.regions[ra.region[i]]
                 assert r.cell == cid
                 assert (r.aspect == "WA1") == (s.det_sign > 0)
                 regions.append(r.id)
-            if dom:
-                domains.append(dom.pop())
+            if i >= 0 and ra.domain[i] >= 0:
+                domains.append(int(ra.domain[i]))
         assert len(regions) == len(set(regions))
         assert len(domains) == len(set(domains))
         labelled += len(regions)
@@ -119,9 +114,8 @@ def test_witnesses_are_confirmed_by_an_independent_solve(chain, paper_geometry):
         for s in res.solutions:
             if s.det_sign != sign:
                 continue
-            box = np.asarray(s.box)
-            inside = np.flatnonzero(np.all((p.lo <= box[:, 0]) & (box[:, 1] <= p.hi), axis=1))
-            pieces = {int(ra.piece[i]) for i in inside if ra.piece[i] >= 0}
+            i = p.locate_boxes(np.asarray(s.box)[None])[0]
+            pieces = {int(ra.piece[i])} if i >= 0 and ra.piece[i] >= 0 else set()
             found.extend(pieces)
         assert set(w.pieces) <= set(found)
         assert len(set(w.pieces)) == len(w.pieces)
@@ -151,20 +145,43 @@ def test_uniqueness_domains_on_a_small_graph():
     assert len(groups) == 4
 
 
-def test_label_of_table1_solutions(chain):
+def test_label_pose_reports_what_the_paving_certifies(chain, paper_geometry):
+    """label_pose on Table 1's six certified solutions, on points of region boxes and off the workspace.
+
+    * each of the six solutions is in W and in the aspect of its certified det A sign
+      (decided at this depth), and its region / domain are exactly those of the paving
+      box holding it (None only when that box has none);
+    * a point drawn inside a box with a basic region gets that region, its aspect and its domain;
+    * B1 on A1 (rho_1 = 0) is certainly outside W; a pose beyond the paved domain lies in no box.
+
+    Would catch a lookup that returns the label of a neighbouring box, drops the aspect, or
+    answers "undecided" where the paving has decided.
+    """
     jp, ra = chain
-    rows = {2: ("-5.495660815453", "-13.935498276039", "-0.047331369367"),
-            3: ("-14.896128100173", "1.582961661963", "0.245309530992"),
-            6: ("14.673943655735", "-3.012603124926", "2.132904365129")}
-    seen = []
-    for k, pose in rows.items():
+    p = ra.paving
+    table1 = solve(paper_geometry, [Fraction("14.98"), Fraction("15.38"), Fraction("12.0")])
+    assert table1.complete and table1.count == 6
+
+    def own(i, column):
+        return int(column[i]) if column[i] >= 0 else None
+
+    for s in table1.solutions:
+        pose = [repr(float(v)) for v in s.midpoint]
         lab = label_pose(ra, pose)
-        assert lab["aspect"] in ("WA1", "undecided")
-        if lab["uniqueness_domain"] != "undecided":
-            seen.append(lab["uniqueness_domain"])
-    assert len(seen) == len(set(seen))
-    out = label_pose(ra, ("40", "40", "0"))
-    assert out["boxes"] == 0 or out["in_workspace"] in ("no", "undecided")
+        assert lab.in_workspace is True and lab.aspect == s.aspect, (pose, lab)
+        i = p.locate_boxes(np.asarray(s.box)[None])[0]
+        assert i >= 0
+        assert (lab.basic_region, lab.uniqueness_domain) == (own(i, ra.region), own(i, ra.domain))
+    rng = np.random.default_rng(12)
+    for i in rng.choice(np.flatnonzero(ra.region >= 0), size=40, replace=False):
+        X = p.lo[i] + rng.uniform(0.1, 0.9, 3) * (p.hi[i] - p.lo[i])
+        lab = label_pose(ra, [repr(float(v)) for v in X])
+        r = ra.regions[ra.region[i]]
+        assert (lab.basic_region, lab.aspect, lab.uniqueness_domain) == (r.id, r.aspect, own(i, ra.domain))
+    out = label_pose(ra, ("0", "0", "0.5"))
+    assert out.in_workspace is False and out.aspect is None and out.boxes > 0
+    far = label_pose(ra, ("40", "40", "0"))
+    assert far.boxes == 0 and far.in_workspace is None and far.basic_region is None
 
 
 # --------------------------------------------------------------------------------------
@@ -217,88 +234,3 @@ def test_sheets_of_pieces_match_the_solutions_of_their_cell(chain, paper_geometr
             assert len(sheets) == len(set(sheets))
             checked += len(sheets)
     assert checked > 50
-
-
-def _fold_segment(geometry):
-    """A singular pose X_s of W, q_s = g(X_s), and a joint step dq that crosses g(S) there.
-
-    Along q_s + s dq the two solutions near X_s exist for s < 0 and merge at s = 0.
-    """
-    from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics, approx_jacobian
-
-    xs = np.linspace(-30, 30, 6001)
-    P = np.stack([xs, np.full_like(xs, -10.0), np.full_like(xs, 0.3)], axis=1)
-    d = approx_det_a(geometry, P)
-    for i in np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:])):
-        a, b = P[i].copy(), P[i + 1].copy()
-        for _ in range(60):
-            mid = 0.5 * (a + b)
-            if np.sign(approx_det_a(geometry, mid[None])[0]) == np.sign(approx_det_a(geometry, a[None])[0]):
-                a = mid
-            else:
-                b = mid
-        x_s = 0.5 * (a + b)
-        q_s = approx_inverse_kinematics(geometry, x_s[None])[0]
-        if np.all((q_s > 12) & (q_s < 30)):
-            break
-    else:  # pragma: no cover
-        pytest.fail("no singular pose on the search line")
-    u, _, _ = np.linalg.svd(approx_jacobian(geometry, x_s[None])[0])
-    dq = u[:, 2] / (2 * q_s)  # moves rho^2 along the left null vector of A: across the fold
-    dq = 0.02 * dq / np.linalg.norm(dq)
-    return x_s, q_s, dq
-
-
-def test_parameter_krawczyk_refuses_steps_across_a_fold(paper_geometry):
-    """Krawczyk over [t0, t1] holding the fold is refused; tracking stops before it, never past it."""
-    from intervalkin.core.interval import Interval
-
-    x_s, q_s, dq = _fold_segment(paper_geometry)
-    side = None
-    for s in (-1.0, 1.0):
-        p, conv = _newton(paper_geometry, x_s[None] + 0.05, (q_s + s * dq)[None], iters=40)
-        if conv[0] and np.max(np.abs(p[0] - x_s)) < 2.0:
-            side, start = s, p[0]
-    assert side is not None
-    qa = Interval.point((q_s + side * dq)[None])
-    qb = Interval.point((q_s - side * dq)[None])  # q(1/2) = q_s is on g(S)
-    # any box around the singular pose, over a parameter range holding t = 1/2: refused
-    for r in (1e-3, 1e-2, 0.1, 1.0):
-        lo, hi = x_s[None] - r, x_s[None] + r
-        ok, _, _ = krawczyk_segment(paper_geometry, lo, hi, qa, qb, np.array([0.4]), np.array([0.6]))
-        assert not ok[0]
-    # from the side with solutions, across the fold: the track must give up
-    z = np.stack([start - 1e-9, start + 1e-9])
-    tr = track(paper_geometry, new_tracks(qa, qb, start[None], z[0][None], z[1][None]))
-    assert tr.status[0] == -1 and tr.t[0] < 0.5
-    # the same solution tracked to just before the fold: certified, and it ends near the fold
-    near = Interval.point((q_s + side * 0.1 * dq)[None])
-    tr = track(paper_geometry, new_tracks(qa, near, start[None], z[0][None], z[1][None]))
-    assert tr.status[0] == 1
-    assert np.all(tr.x_lo[0] <= tr.p[0]) and np.all(tr.p[0] <= tr.x_hi[0])
-
-
-def test_tracked_box_holds_the_certified_solution_at_the_end(paper_geometry):
-    """Tracks between two exact joint vectors end in boxes holding exactly the solver's solutions there."""
-    from intervalkin.core.interval import Interval
-
-    qa = (Fraction(15), Fraction(20), Fraction(18))
-    qb = (Fraction(31, 2), Fraction(39, 2), Fraction(18))
-    ra, rb = solve(paper_geometry, qa), solve(paper_geometry, qb)
-    assert ra.complete and rb.complete and len(ra.solutions) == len(rb.solutions)
-    m = len(ra.solutions)
-    A = Interval.point(np.tile([float(v) for v in qa], (m, 1)))
-    B = Interval.point(np.tile([float(v) for v in qb], (m, 1)))
-    boxes = np.array([np.asarray(s.box) for s in ra.solutions])
-    tr = track(paper_geometry, new_tracks(A, B, boxes.mean(axis=2), boxes[:, :, 0], boxes[:, :, 1]))
-    assert np.all(tr.status == 1)
-    ends = np.array([np.asarray(s.box) for s in rb.solutions])
-    seen = []
-    for i in range(m):
-        inside, apart = compare_mod_2pi(np.repeat(tr.x_lo[i:i + 1], m, 0), np.repeat(tr.x_hi[i:i + 1], m, 0),
-                                          ends[:, :, 0], ends[:, :, 1])
-        assert inside.sum() == 1 and apart.sum() == m - 1  # each track ends on exactly one solution
-        j = int(np.flatnonzero(inside)[0])
-        assert ra.solutions[i].det_sign == rb.solutions[j].det_sign  # no fold on the way: same aspect
-        seen.append(j)
-    assert sorted(seen) == list(range(m))

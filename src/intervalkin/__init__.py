@@ -1,9 +1,17 @@
 """intervalkin: certified definition sets of the planar 3-RPR parallel manipulator.
 
+The library in four calls (each result says what is proved; see the README's "Library")::
+
+    intervalkin.solve(rho, geometry=None)          -> DkpResult: every assembly mode, each proved unique
+    intervalkin.analyse(geometry=None, depth=8)    -> Analysis: joint cells, basic regions, uniqueness domains
+        Analysis.label(pose), Analysis.locate(rho), Analysis.counts()
+    intervalkin.verify(path)                       -> VerifyReport: the independent checker's verdicts
+
 Layers, from the ground floor up (a layer imports only the layers below it; the
 import-linter contract in ``pyproject.toml`` enforces it):
 
-core/        the manipulator as exact data, interval arithmetic (the one rounding layer), errors, files
+core/        the manipulator as exact data, interval arithmetic (the one rounding layer), errors,
+             files, statuses and counts
 kinematics/  g, A, det A and the sextic: written once, evaluated in float, intervals and arb
 paving/      octree box trees, tri-state labels, adjacency with the phi seam, memory budget, predicates
 solve/       certified direct kinematics; continuation of solutions along joint-space paths
@@ -13,8 +21,8 @@ certify/     claim files written from the results above
 pipeline     the whole analysis as one library call
 app/         the ``intervalkin`` command, output folders, report, export, figures, animation
 
-The public names below are loaded on first use, so ``import intervalkin.checker``
-does not pull in numpy or the paving code.
+The public names below are loaded on first use, so ``import intervalkin`` and
+``import intervalkin.checker`` do not pull in numpy or the paving code.
 """
 
 from __future__ import annotations
@@ -34,13 +42,28 @@ _API = {
     "default_geometry": "intervalkin.core.geometry",
     "load_geometry": "intervalkin.core.geometry",
     "Interval": "intervalkin.core.interval",
+    "Status": "intervalkin.core.status",
+    "Count": "intervalkin.core.status",
+    "DkpResult": "intervalkin.solve.solutions",
+    "DkpSolution": "intervalkin.solve.solutions",
+    "PoseLabel": "intervalkin.space.pose_label",
     "DEFAULT_DEPTH": "intervalkin.pipeline",
+    "Analysis": "intervalkin.pipeline",
+    "JointLocation": "intervalkin.pipeline",
+    "ProgressEvent": "intervalkin.pipeline",
+    "VerifyReport": "intervalkin.pipeline",
+    "analyse": "intervalkin.pipeline",
+    "verify": "intervalkin.pipeline",
 }
+# ``intervalkin.solve`` is the solve/ layer itself, which is callable (see its docstring)
+_LAYERS = {"solve"}
 
-__all__ = ["__version__", *_API]
+__all__ = ["__version__", *_API, *_LAYERS]
 
 
 def __getattr__(name: str):
+    if name in _LAYERS:
+        return importlib.import_module(f"intervalkin.{name}")
     module = _API.get(name)
     if module is None:
         raise AttributeError(f"module 'intervalkin' has no attribute {name!r}")

@@ -1,107 +1,321 @@
-"""The whole workspace chain for one geometry, writing one output folder.
+"""The whole analysis of one manipulator as one library call, with typed, certified results.
 
-``run_pave`` (the ``intervalkin pave`` command) paves W, the sign of det A and the
-aspects, finds the aspects as connected components, and writes::
+:func:`analyse` runs the chain of DESIGN.md section 5 for a geometry:
 
-    DIR/pavings/workspace.npz    boxes and labels (format: intervalkin.app.export)
-    DIR/pavings/workspace.vtu    the same as a VTK unstructured grid of hexahedra
-    DIR/figures/*.png            3-D views and phi-slices
-    DIR/summary.json             counts, volumes, components, timings, what is certified
+1. the singular layer: workspace boxes (depth + 1) covering every singular point of W;
+2. joint space: the outer enclosure of g(S) built from their images, and the cells of
+   certified solution count (2**min(depth - 1, 7) voxels per axis);
+3. the regions paving (depth): W, the sign of det A, the aspects, the boxes certified off
+   the characteristic surfaces; their pieces, sheets and basic regions, the distinctness
+   witnesses;
+4. the uniqueness domains.
+
+It returns an :class:`Analysis`: the joint cells, the regions, the counts with their
+certified bounds (:class:`~intervalkin.core.status.Count`), and two questions asked of
+them, :meth:`Analysis.label` (a pose) and :meth:`Analysis.locate` (a joint vector), each
+answered with a :class:`~intervalkin.core.status.Status`.  :func:`verify` re-checks a
+certificate folder with the independent checker.
+
+Nothing here prints: the stages are reported to an optional ``progress`` callback as
+:class:`ProgressEvent` objects, and bad arguments raise
+:class:`~intervalkin.core.errors.InputError` naming the parameter.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import time
+from contextlib import contextmanager
 from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+from typing import Any, Callable, Iterator, Mapping, Sequence
 
-from intervalkin.app.progress import Stages
+from intervalkin.certify.writer import write_certificates
+from intervalkin.checker import INDEX, CheckResult, verify_directory
 from intervalkin.core.errors import InputError
+from intervalkin.core.geometry import Geometry, default_geometry
+from intervalkin.core.status import Status
 from intervalkin.paving.budget import check_depth
-from intervalkin.space.basic_region import analyse_regions
-from intervalkin.space.joint_space import joint_paving
+from intervalkin.solve import dkp
+from intervalkin.space.basic_region import (
+    RegionAnalysis,
+    RegionCounts,
+    analyse_regions,
+    label_pose,
+)
+from intervalkin.space.joint_space import JointPaving, joint_paving
+from intervalkin.space.pose_label import PoseLabel
 from intervalkin.space.singular_surface import pave_singular_layer
 
-__all__ = ['Analysis', 'analyse']
+__all__ = ["DEFAULT_DEPTH", "MAX_CHAIN_DEPTH", "ProgressEvent", "RefinementStep", "JointLocation", "Analysis",
+           "VerifyReport", "check_chain_depth", "chain_depths", "pave_joint_space", "analyse", "verify"]
+
 #: Workspace depth of the default run (about a minute on two cores).
 DEFAULT_DEPTH = 8
+#: Deepest workspace depth of the chain (its singular layer is paved one level deeper).
 MAX_CHAIN_DEPTH = 9
 
 
-def check_chain_depth(depth) -> int:
-    """A user depth for the chain: an integer in 3..MAX_CHAIN_DEPTH whose singular layer fits in memory."""
+@dataclass(frozen=True)
+class ProgressEvent:
+    """One step of a running analysis, for a progress display.
+
+    ``kind`` is ``"start"``, ``"level"`` (one paving level done; ``level`` holds the
+    paver's statistics: level, depth, boxes, split, seconds) or ``"done"``;
+    ``stage`` names the stage (the key of its time in :attr:`Analysis.timings`);
+    ``seconds`` is the time since the stage started.
+    """
+
+    stage: str
+    kind: str
+    seconds: float
+    level: Mapping[str, Any] | None = None
+
+
+ProgressCallback = Callable[[ProgressEvent], None]
+
+
+@dataclass(frozen=True)
+class RefinementStep:
+    """One depth of the regions paving: whether Proposition 1 was seen in full there.
+
+    ``stopped`` says why the refinement stopped at this depth ("" when it went on).
+    """
+
+    depth: int
+    consistent: bool
+    basic_regions: int
+    stopped: str = ""
+
+    def to_json(self) -> dict:
+        doc: dict = {"depth": self.depth, "consistent": self.consistent, "basic_regions": self.basic_regions}
+        if self.stopped:
+            doc["stopped"] = self.stopped
+        return doc
+
+
+@dataclass(frozen=True)
+class JointLocation:
+    """Where a joint vector lies in joint space, and its certified number of solutions.
+
+    ``cell`` is the joint cell holding ``rho`` (None on the undecided layer, which may
+    meet g(S)); ``count``, ``n_wa1`` and ``n_wa2`` are the certified numbers of
+    solutions in all, with det A > 0 and with det A < 0 (None when not certified).
+    ``status`` is CERTIFIED or UNDECIDED; ``why`` says what certified the count.
+    """
+
+    rho: tuple[Fraction, Fraction, Fraction]
+    cell: int | None
+    count: int | None
+    n_wa1: int | None
+    n_wa2: int | None
+    status: Status
+    why: str
+
+
+@dataclass(frozen=True, eq=False)
+class Analysis:
+    """The definition sets of one manipulator, as certified pavings and counts.
+
+    Attributes
+    ----------
+    geometry : the manipulator analysed.
+    depth, singular_depth, joint_depth : the regions paving's depth, the singular
+        layer's depth, and the joint grid's (2**joint_depth voxels per axis).
+    joint : the joint-space grid: enclosure of g(S), cells with certified counts.
+    regions : aspects, pieces, basic regions, witnesses, uniqueness domains, per box and in all.
+    timings : seconds per stage, keyed by the stage names of the progress events.
+    refinement : each depth the regions paving was tried at, and why it stopped.
+    """
+
+    geometry: Geometry
+    depth: int
+    singular_depth: int
+    joint_depth: int
+    joint: JointPaving
+    regions: RegionAnalysis
+    timings: Mapping[str, float]
+    refinement: tuple[RefinementStep, ...]
+
+    @property
+    def n_singular_boxes(self) -> int:
+        """Number of workspace boxes whose images make the enclosure of g(S)."""
+        return self.joint.n_singular_boxes
+
+    def counts(self) -> RegionCounts:
+        """Aspects, basic regions and uniqueness domains, each a :class:`~intervalkin.core.status.Count`."""
+        return self.regions.counts()
+
+    def label(self, pose: Sequence) -> PoseLabel:
+        """Certified aspect, basic region and uniqueness domain of a pose (x, y, phi), read exactly."""
+        return label_pose(self.regions, pose)
+
+    def locate(self, rho: Sequence) -> JointLocation:
+        """The joint cell of a joint vector and its certified count and aspect split.
+
+        A vector in a solved cell takes the cell's count (certified at every point of
+        the cell).  Elsewhere (the undecided layer, an unsolved cell) the count comes
+        from a certified solve at ``rho`` itself, or is UNDECIDED when that solve
+        cannot be completed (``rho`` on or very near g(S)).
+        """
+        q = dkp.parse_joint_vector(self.geometry, rho)
+        cid = self.joint.cell_at(q)
+        if cid >= 0 and self.joint.cells[cid].count >= 0:
+            c = self.joint.cells[cid]
+            return JointLocation(q, cid, c.count, c.n_wa1, c.n_wa2, Status.CERTIFIED,
+                                 f"rho lies in joint cell {cid}, certified off g(S); the certified solve at the "
+                                 "cell's witness gives the count at every point of the cell")
+        where = (f"rho lies in joint cell {cid}, whose solve was not completed" if cid >= 0 else
+                 "rho lies on the undecided layer of the joint grid (it may be near g(S))")
+        cell = cid if cid >= 0 else None
+        res = dkp.solve(self.geometry, q)
+        if res.complete and all(s.status == "unique" and s.det_sign != 0 for s in res.solutions):
+            n1 = sum(1 for s in res.solutions if s.det_sign > 0)
+            return JointLocation(q, cell, res.count, n1, res.count - n1, Status.CERTIFIED,
+                                 f"{where}; a certified solve at rho itself gives its count")
+        return JointLocation(q, cell, None, None, None, Status.UNDECIDED,
+                             f"{where}; the solve at rho was not completed ({res.completeness_reason})")
+
+    def write_certificates(self, folder: str | Path, dkp_results: Sequence[dkp.DkpResult] = (),
+                           trajectories: Sequence = ()) -> list[Path]:
+        """Write the certificate folder of this analysis (and of extra solves and paths); return its files.
+
+        :func:`verify` re-proves every claim from the files alone.
+        """
+        return write_certificates(folder, self.geometry, dkp_results=dkp_results, joint=self.joint,
+                                  regions=self.regions, trajectories=trajectories)
+
+
+@dataclass(frozen=True)
+class VerifyReport:
+    """The independent checker's verdicts on one certificate folder, one per claim."""
+
+    folder: Path
+    results: tuple[CheckResult, ...]
+
+    @property
+    def verified(self) -> bool:
+        """True when the folder holds claims and every one of them was re-proved."""
+        return bool(self.results) and all(r.verified for r in self.results)
+
+    @property
+    def failed(self) -> tuple[CheckResult, ...]:
+        """The claims that were not re-proved."""
+        return tuple(r for r in self.results if not r.verified)
+
+
+def check_chain_depth(depth, refine_to=None) -> int:
+    """A depth for the chain: an integer in 3..MAX_CHAIN_DEPTH whose singular layer fits in memory.
+
+    ``refine_to``, when given, must be an integer in depth..MAX_CHAIN_DEPTH.
+    Raises :class:`~intervalkin.core.errors.InputError` naming the parameter.
+    """
     if isinstance(depth, bool) or not isinstance(depth, int) or not 3 <= depth <= MAX_CHAIN_DEPTH:
-        raise InputError(f"--depth: expected an integer in 3..{MAX_CHAIN_DEPTH}, got {depth!r}")
+        raise InputError(f"depth: expected an integer in 3..{MAX_CHAIN_DEPTH}, got {depth!r}")
+    if refine_to is not None and (isinstance(refine_to, bool) or not isinstance(refine_to, int)
+                                  or not depth <= refine_to <= MAX_CHAIN_DEPTH):
+        raise InputError(f"refine_to: expected an integer in {depth}..{MAX_CHAIN_DEPTH}, got {refine_to!r}")
     check_depth(depth + 1)
     return depth
 
 
 def chain_depths(depth: int) -> tuple[int, int, int]:
-    """(workspace depth, singular-layer depth, joint depth) for a user depth."""
+    """(workspace depth, singular-layer depth, joint depth) for a chain depth."""
     return depth, depth + 1, min(depth - 1, 7)
 
 
-@dataclass(frozen=True, eq=False)
-class Analysis:
-    """The definition sets of one manipulator, as certified pavings and counts."""
+class _Stages:
+    """Times the stages of a run and reports them to the progress callback."""
 
-    geometry: object
-    depth: int
-    singular_depth: int
-    joint_depth: int
-    n_singular_boxes: int
-    joint: object
-    regions: object
-    timings: dict
-    refinement: tuple = ()
+    def __init__(self, progress: ProgressCallback | None):
+        self.progress = progress
+        self.timings: dict[str, float] = {}
 
-
-def _singular_and_joint(geometry, singular_depth: int, joint_depth: int, st: Stages):
-    """The singular layer at ``singular_depth`` and the joint cells on 2**joint_depth voxels per axis."""
-
-    st.start(f"singular layer (depth {singular_depth})")
-    sing = pave_singular_layer(geometry, singular_depth, progress=st.bar())
-    st.done()
-    st.start(f"joint space: enclosure of g(S) and certified cells (2^{joint_depth} voxels per axis)")
-    jp = joint_paving(geometry, sing, joint_depth)
-    st.done()
-    return sing, jp
+    @contextmanager
+    def stage(self, name: str) -> Iterator[Callable[[dict], None] | None]:
+        """Time one stage; yields the per-level callback for a paver (None without a progress callback)."""
+        t0 = time.perf_counter()
+        report = self.progress
+        if report is not None:
+            report(ProgressEvent(name, "start", 0.0))
+        levels = None if report is None else (
+            lambda st: report(ProgressEvent(name, "level", time.perf_counter() - t0, dict(st))))
+        yield levels
+        self.timings[name] = time.perf_counter() - t0
+        if report is not None:
+            report(ProgressEvent(name, "done", self.timings[name]))
 
 
-def analyse(geometry, depth: int = DEFAULT_DEPTH, stages: Stages | None = None, refine_to: int | None = None) -> Analysis:
+def _joint_space(geometry: Geometry, singular_depth: int, joint_depth: int, stages: _Stages) -> JointPaving:
+    with stages.stage(f"singular layer (depth {singular_depth})") as levels:
+        singular = pave_singular_layer(geometry, singular_depth, progress=levels)
+    with stages.stage(f"joint space: enclosure of g(S) and certified cells (2^{joint_depth} voxels per axis)"):
+        return joint_paving(geometry, singular, joint_depth)
+
+
+def pave_joint_space(geometry: Geometry | None = None, singular_depth: int = DEFAULT_DEPTH + 1,
+                     joint_depth: int = 7, progress: ProgressCallback | None = None) -> JointPaving:
+    """The singular layer at ``singular_depth`` and the joint cells on 2**joint_depth voxels per axis.
+
+    The joint-space half of :func:`analyse`, on its own: every cell's count and aspect
+    split is certified by one solve; the marked voxels may meet g(S).
+    """
+    geometry = default_geometry() if geometry is None else geometry
+    check_depth(singular_depth)
+    return _joint_space(geometry, singular_depth, joint_depth, _Stages(progress))
+
+
+def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progress: ProgressCallback | None = None,
+            refine_to: int | None = None) -> Analysis:
     """Run the chain geometry -> singular layer -> joint cells -> regions -> uniqueness domains.
 
-    ``depth`` is the octree depth of the workspace paving; the singular layer
-    is paved one level deeper and the joint grid has 2**min(depth - 1, 7) voxels
-    per axis (see :func:`chain_depths`).
+    Parameters
+    ----------
+    geometry : the manipulator; the paper's (Wenger & Chablat 1997) when None.
+    depth : octree depth of the regions paving, 3..MAX_CHAIN_DEPTH (see :func:`chain_depths`
+        for the depths of the other stages).
+    progress : called with a :class:`ProgressEvent` at the start and end of each stage and
+        after each paving level.
+    refine_to : while Proposition 1 is not seen in full (a sheet of a counted cell holds no
+        certified box), pave the regions one level deeper, up to this depth.  The paver
+        splits only undecided boxes, so a deeper level refines near the characteristic
+        surfaces, the singular layer and the joint limits only.
 
-    ``refine_to``: while Proposition 1 is not seen in full (a sheet above a
-    counted cell holds no certified box), pave the regions one level deeper, up
-    to this depth.  The paver only splits undecided boxes, so a deeper level
-    refines near the characteristic surfaces, the singular layer and the joint
-    limits, not the whole domain.  ``Analysis.refinement`` records each try and
-    why it stopped.
+    Raises :class:`~intervalkin.core.errors.InputError` on a bad depth and
+    :class:`~intervalkin.core.errors.ResourceError` when the run would not fit in memory.
     """
-
-    check_chain_depth(depth)
-    st = stages or Stages(quiet=True)
+    geometry = default_geometry() if geometry is None else geometry
+    check_chain_depth(depth, refine_to)
     dw, ds, dj = chain_depths(depth)
-    sing, jp = _singular_and_joint(geometry, ds, dj, st)
-    st.start(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})")
-    ra = analyse_regions(geometry, jp, dw, progress=st.bar())
-    st.done()
-    history = [{"depth": dw, "consistent": ra.consistent, "basic_regions": len(ra.regions)}]
-    if refine_to is not None:
-        if isinstance(refine_to, bool) or not isinstance(refine_to, int) or not dw <= refine_to <= MAX_CHAIN_DEPTH:
-            raise InputError(f"--refine-to: expected an integer in {dw}..{MAX_CHAIN_DEPTH}, got {refine_to!r}")
-        while not ra.consistent and dw < refine_to:
-            dw += 1
-            st.start(f"refining where Proposition 1 is not yet seen in full: regions at depth {dw}")
-            ra = analyse_regions(geometry, jp, dw, progress=st.bar())
-            st.done()
-            history.append({"depth": dw, "consistent": ra.consistent, "basic_regions": len(ra.regions)})
-    if ra.consistent:
-        history[-1]["stopped"] = "consistent: every sheet above every counted cell holds certified boxes"
+    stages = _Stages(progress)
+    joint = _joint_space(geometry, ds, dj, stages)
+    with stages.stage(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})") as levels:
+        regions = analyse_regions(geometry, joint, dw, progress=levels)
+    history = [RefinementStep(dw, regions.consistent, len(regions.regions))]
+    while refine_to is not None and not regions.consistent and dw < refine_to:
+        dw += 1
+        with stages.stage(f"refining where Proposition 1 is not yet seen in full: regions at depth {dw}") as levels:
+            regions = analyse_regions(geometry, joint, dw, progress=levels)
+        history.append(RefinementStep(dw, regions.consistent, len(regions.regions)))
+    if regions.consistent:
+        stopped = "consistent: every sheet above every counted cell holds certified boxes"
     elif refine_to is None:
-        history[-1]["stopped"] = "not consistent at this depth; no refinement asked (--refine-to)"
+        stopped = "not consistent at this depth; no refinement asked"
     else:
-        history[-1]["stopped"] = f"limit reached (depth {dw}) before consistency"
-    return Analysis(geometry, dw, ds, dj, len(sing), jp, ra, dict(st.timings), tuple(history))
+        stopped = f"limit reached (depth {dw}) before consistency"
+    history[-1] = dataclasses.replace(history[-1], stopped=stopped)
+    return Analysis(geometry, dw, ds, dj, joint, regions, dict(stages.timings), tuple(history))
+
+
+def verify(path: str | Path) -> VerifyReport:
+    """Re-prove every claim of a certificate folder with the independent checker (arb only).
+
+    ``path`` is the certificate folder or an output folder holding ``certificates/``.
+    Raises :class:`~intervalkin.core.errors.InputError` (a ``CertificateFormatError``)
+    when the folder or its index is missing or malformed; a claim that does not
+    re-prove is a failed result, not an error.
+    """
+    root = Path(path)
+    folder = root / "certificates" if (root / "certificates" / INDEX).is_file() else root
+    return VerifyReport(folder, tuple(verify_directory(folder)))

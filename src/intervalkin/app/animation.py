@@ -1,113 +1,45 @@
-"""Certified non-singular trajectories between assembly modes of one aspect.
+"""A trajectory written out: ``trajectory.json``, its figures and the animation of the platform.
 
-The paper (section 3.2, Table 1) observes that solutions 2, 3 and 6 of the joint
-vector rho = (14.98, 15.38, 12.0) lie in one aspect WA1, so the platform can move
-from one to another without meeting a type-2 singularity; section 5.2 and
-Figure 13 add that such a motion must pass through an intermediate basic region,
-whose image is a joint-space domain with only two solutions.  This module builds
-such a motion and PROVES it non-singular.
+:func:`write_trajectory` writes the ``--json`` object of a
+:class:`~intervalkin.space.trajectory_result.Trajectory` together with its
+certificate (the evidence the checker re-proves), then
+:func:`render_trajectory` draws
 
-Construction
-------------
-1. The two solutions are the certified direct-kinematic boxes of
-   :func:`dkp.solve` (numbered from 1 in increasing phi, as ``intervalkin dkp``
-   prints them).  Opposite certified signs of det A put them in different
-   aspects: then no non-singular path exists and :class:`NoPathError` says so.
-2. A shortest path (A*, exact for the metric below) in the face-adjacency graph
-   of the paving boxes certified INSIDE the aspect, from the box nearest the
-   start solution to the box nearest the goal.  Edge weight: the distance of the
-   box centres in the metric ``sqrt(dx^2 + dy^2 + (L dphi)^2)``, dphi taken
-   modulo 2 pi and L the root-mean-square distance of the platform points from
-   B1 (so a rotation costs about what it moves the platform).
-3. Waypoints: the start solution, the centre of the face piece shared by each
-   pair of consecutive boxes, the goal solution.  Each straight segment between
-   them lies in one certified box.
-4. Smoothing: a waypoint is dropped when the straight segment that skips it is
-   itself certified (step 5); the farthest certifiable waypoint is searched by
-   doubling then bisection.
+* the path in the workspace (x, y, phi; phi wrapped, so the path is cut where
+  it crosses the seam) over the undecided singular layer of the paving, and its
+  projection on the x-y plane, with the solutions numbered as ``intervalkin dkp``
+  lists them;
+* its image g(path) in joint space, a closed loop through the start joint vector,
+  coloured by the certified solution count of the joint cell each piece maps
+  into, and that count along the path (paper section 5.2, Fig. 13);
+* the platform and legs moving along the path (a GIF with Pillow, PNG frames
+  otherwise).
 
-phi convention
---------------
-Waypoints carry an UNWRAPPED phi: phi is continuous along the path, it starts at
-the start solution's phi (in (-pi, pi]) and may leave (-pi, pi] when the path
-crosses the seam phi = +-pi.  The last waypoint is the goal solution's phi plus
-``2 pi * phi_turns``.  Take phi modulo 2 pi to get the usual pose.  The
-kinematics are 2 pi periodic in phi, so nothing else changes.
-
-Certificate (proofs/lemma-trajectory-certificate.md)
-----------------------------------------------------
-The motion is the concatenation of the exact straight segments
-P(t) = A + t (B - A), t in [0, 1], between consecutive waypoints, where the
-first A and the last B are the EXACT solutions (known through their enclosures)
-and the other waypoints are the floats stored.  For each segment, [0, 1] is cut
-into pieces [t0, t1]; the interval expression A + [t0, t1] (B - A) (outward
-rounded, A and B as intervals) is a box containing the piece of the segment,
-and on that box :func:`kinematics.det_a_interval` is proved of the aspect's sign
-and :func:`kinematics.rho_sq_interval` proved within [rho_min^2, rho_max^2] for
-every leg.  Failing pieces are bisected; past :data:`MAX_BISECTIONS` halvings
-the segment is not certified (``certified`` False, with the reason).  This test
-does not use the paving at all: the paving only proposes the path.
-
-Also reported, with what each claim rests on:
-
-* the basic regions crossed (when a :class:`~intervalkin.space.basic_region.RegionAnalysis`
-  is given): region ids of the paving leaves met by points sampled along the
-  path at steps below half the finest leaf width, consecutive repeats merged,
-  -1 ("layer") where the leaf carries no region (the enclosure of S_c or an
-  undecided sheet).  Sampled, so a region touched only between two samples
-  could be missed;
-* the joint-space image (when a :class:`~intervalkin.space.joint_space.JointPaving` is
-  given): each piece of each segment is enclosed in a box, its interval image
-  g(box) computed, and :meth:`JointPaving.cell_of_boxes` names the cell that
-  contains it: a certified statement "this piece maps into cell c", whose count
-  is certified.  Pieces whose image may meet g(S) are reported as "layer".
-  Unlike ``cell_at`` on rounded joint vectors, this covers every point of the path.
-
-In both sequences a layer stretch between two visits of the same region (or
-cell) is merged into it: the path left the certified part and came back, and
-what it met meanwhile is not resolved at this depth.  The raw per-sample region
-ids are kept in ``Trajectory.sample_region``.
+Every file is written atomically (:mod:`intervalkin.core.files`).  The figures
+illustrate a certified motion; the certificate is in the JSON, not in them.
 """
 
 from __future__ import annotations
 
 import math
-import os
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from intervalkin.app.figures import pyplot, save_png
 from intervalkin.core.files import atomic_write_bytes, write_json
 from intervalkin.core.geometry import Geometry
-from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 from intervalkin.space.joint_space import JointPaving
-from intervalkin.space.path_search import _dist, _metric_length, _wrap
-from intervalkin.space.trajectory import Trajectory
+from intervalkin.space.path_search import metric_length, path_distance, wrap_phi
+from intervalkin.space.singular_surface import may_be_singular
+from intervalkin.space.trajectory_result import Trajectory
 
 __all__ = ['render_trajectory', 'write_trajectory']
 
-
-# --------------------------------------------------------------------------------------
-# Output: JSON and figures (atomic)
-# --------------------------------------------------------------------------------------
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _save_png(fig, path: Path) -> Path:
-    import io
-
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    return atomic_write_bytes(path, buf.getvalue())
+#: Resolution of the trajectory figures and frames.
+_DPI = 110
 
 
 def _platform(geometry: Geometry, pose: np.ndarray):
@@ -125,13 +57,13 @@ def _platform(geometry: Geometry, pose: np.ndarray):
 def _segments_3d(samples: np.ndarray):
     """Split a path at the phi seam: list of (k, 3) arrays with wrapped phi."""
     w = samples.copy()
-    w[:, 2] = _wrap(w[:, 2])
+    w[:, 2] = wrap_phi(w[:, 2])
     jumps = np.flatnonzero(np.abs(np.diff(w[:, 2])) > math.pi) + 1
     return np.split(w, jumps)
 
 
 def render_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, paving: Paving | None = None,
-                      joint: "JointPaving | None" = None, frames: int = 48) -> list[Path]:
+                      joint: JointPaving | None = None, frames: int = 48) -> list[Path]:
     """Write the figures of a trajectory into folder ``out`` (atomically); returns the paths.
 
     * ``trajectory_workspace_3d.png``: the path in (x, y, phi), phi wrapped, over
@@ -143,7 +75,7 @@ def render_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, pav
     * ``trajectory_animation.gif`` (Pillow) or ``trajectory_frames/frame_NNN.png``:
       the platform and legs moving.
     """
-    plt = _plt()
+    plt = pyplot()
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
@@ -152,7 +84,7 @@ def render_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, pav
     colour = "#1f77b4" if traj.sign > 0 else "#d62728"
     layer = None
     if paving is not None:
-        sel = np.flatnonzero((paving.labels["W"] != Label.OUTSIDE) & (paving.labels["det_positive"] == Label.BOUNDARY))
+        sel = np.flatnonzero(may_be_singular(paving.labels))
         if sel.size > 6000:
             sel = np.sort(rng.choice(sel, 6000, replace=False))
         layer = 0.5 * (paving.lo[sel] + paving.hi[sel])
@@ -174,7 +106,7 @@ def render_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, pav
     ax.set_zlabel("phi (rad)")
     ax.set_title(title, fontsize=9)
     ax.legend(loc="upper left", fontsize=8)
-    written.append(_save_png(fig, out / "trajectory_workspace_3d.png"))
+    written.append(save_png(fig, out / "trajectory_workspace_3d.png", dpi=_DPI))
     plt.close(fig)
 
     # x-y projection
@@ -191,7 +123,7 @@ def render_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, pav
     ax.set_ylabel("y (B1)")
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=8)
-    written.append(_save_png(fig, out / "trajectory_workspace_xy.png"))
+    written.append(save_png(fig, out / "trajectory_workspace_xy.png", dpi=_DPI))
     plt.close(fig)
 
     # joint space
@@ -201,8 +133,7 @@ def render_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, pav
         idx = np.argwhere(joint.marked)
         if idx.shape[0] > 8000:
             idx = idx[rng.choice(idx.shape[0], 8000, replace=False)]
-        r0 = np.array([float(v) for v in joint.rho_min])
-        h = np.array([float(v) for v in joint.step])
+        r0, h = joint.approx_grid()
         vox = r0 + (idx + 0.5) * h
         ax.scatter(vox[:, 0], vox[:, 1], vox[:, 2], s=2, c="0.6", alpha=0.2, label="enclosure of g(S)")
     counts = traj.sample_count if traj.sample_count is not None else np.full(len(traj.samples), -1)
@@ -219,7 +150,7 @@ def render_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, pav
     ax.legend(fontsize=7, loc="upper left")
     ax.set_title("image g(path): a closed loop in joint space", fontsize=9)
     ax2 = fig.add_subplot(1, 2, 2)
-    s_along = np.concatenate([[0.0], np.cumsum(_dist(traj.samples[:-1], traj.samples[1:], _metric_length(geometry)))])
+    s_along = np.concatenate([[0.0], np.cumsum(path_distance(traj.samples[:-1], traj.samples[1:], metric_length(geometry)))])
     ax2.step(s_along, np.where(counts >= 0, counts, np.nan), where="post", color="k")
     ax2.scatter(s_along[counts < 0], np.full(np.count_nonzero(counts < 0), 0.5), s=3, color="0.5",
                 label="image may meet g(S)")
@@ -228,7 +159,7 @@ def render_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, pav
     ax2.set_ylabel("certified number of solutions of g(X)")
     ax2.set_title("solution count along the path (joint cells)", fontsize=9)
     ax2.legend(fontsize=8)
-    written.append(_save_png(fig, out / "trajectory_joint.png"))
+    written.append(save_png(fig, out / "trajectory_joint.png", dpi=_DPI))
     plt.close(fig)
 
     written += _render_animation(traj, geometry, out, frames)
@@ -236,10 +167,10 @@ def render_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, pav
 
 
 def _render_animation(traj: Trajectory, geometry: Geometry, out: Path, frames: int) -> list[Path]:
-    plt = _plt()
+    plt = pyplot()
     s = traj.samples
-    L = _metric_length(geometry)
-    arc = np.concatenate([[0.0], np.cumsum(_dist(s[:-1], s[1:], L))])
+    L = metric_length(geometry)
+    arc = np.concatenate([[0.0], np.cumsum(path_distance(s[:-1], s[1:], L))])
     targets = np.linspace(0.0, arc[-1], frames)
     poses = np.stack([np.interp(targets, arc, s[:, j]) for j in range(3)], axis=1)
     allpts = np.vstack([_platform(geometry, p)[1] for p in poses] + [_platform(geometry, poses[0])[0]])
@@ -275,32 +206,23 @@ def _render_animation(traj: Trajectory, geometry: Geometry, out: Path, frames: i
         from matplotlib.animation import FuncAnimation, PillowWriter
 
         anim = FuncAnimation(fig, draw, frames=len(poses))
-        final = out / "trajectory_animation.gif"
-        fd, tmp = tempfile.mkstemp(prefix=".trajectory_animation.", suffix=".gif", dir=out)
-        os.close(fd)
-        try:
-            anim.save(tmp, writer=PillowWriter(fps=12), dpi=80)
-            os.chmod(tmp, 0o644)
-            os.replace(tmp, final)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
-        written.append(final)
+        with tempfile.TemporaryDirectory() as scratch:  # Pillow writes to a named file
+            gif = Path(scratch) / "trajectory_animation.gif"
+            anim.save(gif, writer=PillowWriter(fps=12), dpi=80)
+            written.append(atomic_write_bytes(out / "trajectory_animation.gif", gif.read_bytes()))
     else:
         folder = out / "trajectory_frames"
         folder.mkdir(exist_ok=True)
         for k in range(len(poses)):
             draw(k)
-            written.append(_save_png(fig, folder / f"frame_{k:03d}.png"))
+            written.append(save_png(fig, folder / f"frame_{k:03d}.png", dpi=_DPI))
     plt.close(fig)
     return written
 
 
 def write_trajectory(traj: Trajectory, geometry: Geometry, out: str | Path, paving: Paving | None = None,
-                     joint: "JointPaving | None" = None) -> list[Path]:
+                     joint: JointPaving | None = None) -> list[Path]:
     """``trajectory.json`` (the --json object plus the certificate) and the figures, atomically."""
-
     out = Path(out)
     doc = traj.to_json()
     doc["certificate"] = traj.certificate()

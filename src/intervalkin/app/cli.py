@@ -10,16 +10,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 from typing import Callable, Sequence
 
-from intervalkin.app.commands import (
-    run_analyze,
-    run_joint,
-    run_label,
-    run_pave,
-    run_trajectory,
-)
+from intervalkin.app.commands import run_analyze, run_joint, run_pave, run_trajectory
+from intervalkin.app.label import run_label
 from intervalkin.app.options import geometry_from_option
 from intervalkin.app.table1 import format_table1, table1_comparison
 from intervalkin.app.text import format_dkp_table
@@ -132,7 +128,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     p = sub.add_parser("dkp", help="certified direct kinematics: every assembly mode of a joint vector")
-    p.add_argument("rho", nargs=3, metavar=("R1", "R2", "R3"), help="leg lengths (exact decimals)")
+    # one metavar string: argparse (3.11) crashes on a tuple metavar of a positional in --help and in
+    # its "arguments are required" message
+    p.add_argument("rho", nargs=3, metavar="RHO", help="the three leg lengths R1 R2 R3 (exact decimals)")
     p.add_argument("--geometry", metavar="FILE", help="geometry TOML file (default: the paper's manipulator)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -168,7 +166,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "holds certified boxes (Proposition 1 seen in full)")
 
     p = sub.add_parser("label", help="certified aspect, basic region and uniqueness domain of a pose")
-    p.add_argument("pose", nargs=3, metavar=("X", "Y", "PHI"), help="pose: B1 = (X, Y), angle PHI in radians")
+    p.add_argument("pose", nargs=3, metavar="POSE", help="the pose X Y PHI: B1 = (X, Y), angle PHI in radians")
     p.add_argument("--geometry", metavar="FILE")
     p.add_argument("--depth", type=int, default=7, metavar="N", help="depth of the analysis (default 7)")
     p.add_argument("--from", dest="source", metavar="DIR", help="read the pavings of an earlier analyze/paper output")
@@ -194,8 +192,6 @@ def _terminate(signum, frame):  # pragma: no cover - exercised through a subproc
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    import signal
-
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

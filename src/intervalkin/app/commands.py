@@ -1,21 +1,20 @@
-"""The whole workspace chain for one geometry, writing one output folder.
+"""The command handlers that compute and write an output folder: pave, joint, analyze, paper, trajectory.
 
-``run_pave`` (the ``intervalkin pave`` command) paves W, the sign of det A and the
-aspects, finds the aspects as connected components, and writes::
-
-    DIR/pavings/workspace.npz    boxes and labels (format: intervalkin.app.export)
-    DIR/pavings/workspace.vtu    the same as a VTK unstructured grid of hexahedra
-    DIR/figures/*.png            3-D views and phi-slices
-    DIR/summary.json             counts, volumes, components, timings, what is certified
+Each ``run_*`` function backs one sub-command of :mod:`intervalkin.app.cli`: it
+reads the options, calls the library (:mod:`intervalkin.pipeline` and the layers
+below), writes the output folder through :mod:`intervalkin.app.output`, prints
+the short table on stdout (progress goes to stderr) and returns the exit status
+0.  Bad input raises :class:`~intervalkin.core.errors.IntervalkinError`, which the
+command line turns into one line on stderr and status 2.  Nothing here proves
+anything: every claim printed or written comes from the library's results.
 """
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from pathlib import Path
-
-import numpy as np
 
 from intervalkin.app.animation import write_trajectory
 from intervalkin.app.export import paving_columns, write_npz, write_vtu_paving
@@ -23,19 +22,20 @@ from intervalkin.app.figures import render_all, render_joint
 from intervalkin.app.options import geometry_from_option
 from intervalkin.app.output import (
     MARKER,
-    _npz_bytes,
-    _write_certificates,
+    npz_bytes,
     prepare_output_dir,
+    writable_folder,
+    write_analysis_certificates,
     write_chain,
 )
 from intervalkin.app.progress import ProgressBar, Stages
 from intervalkin.app.report import write_report
 from intervalkin.app.summary import (
-    _table,
     chain_table,
     joint_summary,
     joint_table,
     pave_summary,
+    pave_table,
 )
 from intervalkin.app.table1 import TABLE1_RHO
 from intervalkin.core.errors import InputError, IntervalkinError
@@ -45,31 +45,22 @@ from intervalkin.paving.adjacency import shares_face
 from intervalkin.paving.budget import check_depth
 from intervalkin.paving.labels import Label
 from intervalkin.paving.predicates import pave_workspace
-from intervalkin.pipeline import (
-    Analysis,
-    _singular_and_joint,
-    analyse,
-    check_chain_depth,
-)
+from intervalkin.pipeline import Analysis, analyse, check_chain_depth, pave_joint_space
 from intervalkin.space.aspect import aspect_components
-from intervalkin.space.basic_region import label_pose
 from intervalkin.space.trajectory import check_request, trajectory
 
-__all__ = ['run_pave', 'run_analyze']
+__all__ = ['run_pave', 'run_joint', 'run_analyze', 'run_trajectory']
 
 
 def run_pave(geometry_path, depth, out, figures: bool = True, progress: bool = True) -> int:
-    """Pave W, det A sign and the aspects at ``depth`` and write everything into ``out``.
+    """``intervalkin pave``: W, the det A sign and the aspects at ``depth``, written into ``out``.
 
     Validates ``depth`` (integer 1..MAX_DEPTH, memory estimate against
-    MemAvailable) before any work; returns the exit status 0.
+    MemAvailable) before any work.
     """
-
     depth = check_depth(depth)
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out: {str(out)!r} exists and is not a folder")
     geometry = geometry_from_option(geometry_path)
+    out = writable_folder(out)  # refused before the paving, not after
     t0 = time.perf_counter()
     paving = pave_workspace(geometry, depth, progress=ProgressBar() if progress else None)
     t1 = time.perf_counter()
@@ -82,78 +73,30 @@ def run_pave(geometry_path, depth, out, figures: bool = True, progress: bool = T
                      {k: cols[k] for k in ("in_workspace", "det_sign", "aspect", "depth")},
                      mask=paving.labels["W"] != Label.OUTSIDE)
     t3 = time.perf_counter()
-    fig_files = []
-    if figures:
-
-        fig_files = render_all(paving, out / "figures", base=geometry.base)
+    fig_files = render_all(paving, out / "figures", base=geometry.base) if figures else []
     t4 = time.perf_counter()
     timings = {"paving": t1 - t0, "components": t2 - t1, "export": t3 - t2, "figures": t4 - t3, "total": t4 - t0}
     summary = pave_summary(paving, info, timings)
     summary["geometry"] = geometry.name
     summary["files"] = ["pavings/workspace.npz", "pavings/workspace.vtu"] + [f"figures/{f.name}" for f in fig_files]
     write_json(out / "summary.json", summary)
-    sys.stdout.write(_table(summary) + "\n")
-    return 0
-
-
-def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool = False, as_json: bool = False,
-                figures: bool = True, certificates: bool = True, paper: bool = False,
-                refine_to: int | None = None) -> int:
-    """``intervalkin analyze`` (and ``paper`` when paper=True): the whole chain into one folder."""
-    import json
-
-
-    geometry = default_geometry() if paper else geometry_from_option(geometry_path)
-    check_chain_depth(depth)
-    out = prepare_output_dir(out, force)
-    st = Stages(quiet=quiet)
-    a = analyse(geometry, depth, st, refine_to=refine_to)
-    summary = write_chain(a, out, figures=figures, stages=st)
-    trajs = []
-    if paper:  # before the certificates, which re-check these paths
-        st.start("certified trajectories between Table 1's solutions 2, 3, 6")
-        summary["trajectories"], trajs = _paper_trajectories(a, out, summary["files"])
-        st.done()
-    if certificates:
-        st.start("certificates")
-        cert_files = _write_certificates(a, out, trajectories=trajs)
-        st.done()
-        summary["files"] += cert_files
-    if paper:
-        st.start("paper report")
-
-        summary["timings_seconds"] = {**summary["timings_seconds"], **st.timings,
-                                      "total": time.perf_counter() - st.t0}
-
-        summary["files"].append(write_report(a, summary, out, st.timings))
-        st.done()
-    summary["timings_seconds"] = {**summary["timings_seconds"], **st.timings,
-                                  "total": time.perf_counter() - st.t0}
-
-    write_json(out / "summary.json", summary)
-    if as_json:
-        sys.stdout.write(json.dumps(summary) + "\n")
-    elif not quiet:
-        sys.stdout.write(chain_table(summary) + f"\nwritten to {out}/ in {summary['timings_seconds']['total']:.1f} s\n")
+    sys.stdout.write(pave_table(summary) + "\n")
     return 0
 
 
 def run_joint(geometry_path, depth: int, out, force: bool = False, quiet: bool = False, figures: bool = True) -> int:
     """``intervalkin joint``: the enclosure of g(S), the certified cells and their table."""
-
     if isinstance(depth, bool) or not isinstance(depth, int) or not 2 <= depth <= 8:
         raise InputError(f"--depth: expected an integer in 2..8 (voxels per axis 2**depth), got {depth!r}")
     geometry = geometry_from_option(geometry_path)
     out = prepare_output_dir(out, force)
     st = Stages(quiet=quiet)
     ds = min(depth + 2, 10)
-    check_depth(ds)
-    _, jp = _singular_and_joint(geometry, ds, depth, st)
-    atomic_write_bytes(out / "pavings" / "joint.npz", _npz_bytes(jp.columns()))
+    jp = pave_joint_space(geometry, ds, depth, progress=st)
+    atomic_write_bytes(out / "pavings" / "joint.npz", npz_bytes(jp.columns()))
     files = ["pavings/joint.npz"]
     if figures:
         st.start("figures")
-
         files += [f"figures/{f.name}" for f in render_joint(jp, out / "figures")]
         st.done()
     summary = {"geometry": geometry.name, "singular_depth": ds, "joint": joint_summary(jp),
@@ -164,69 +107,39 @@ def run_joint(geometry_path, depth: int, out, force: bool = False, quiet: bool =
     return 0
 
 
-def run_label(geometry_path, pose, depth: int, source=None, as_json: bool = False) -> int:
-    """``intervalkin label X Y PHI``: certified aspect, basic region and uniqueness domain of a pose."""
-    import json
-    from fractions import Fraction
-
-
-    try:
-        exact = [Fraction(str(v)) for v in pose]
-    except (ValueError, ZeroDivisionError):
-        raise InputError(f"pose: expected three numbers X Y PHI, got {' '.join(map(str, pose))}") from None
-    if source is not None:
-        res = _label_from_npz(Path(source), exact)
-        res["pose"] = [str(v) for v in pose]
-    else:
-        geometry = geometry_from_option(geometry_path)
-
-        a = analyse(geometry, depth)
-        res = label_pose(a.regions, [str(v) for v in pose])
-    if res["aspect"] in ("WA1", "WA2") and res["basic_region"] == "undecided":
-        res["note"] = ("certified inside the aspect, but the box holding the pose may meet a characteristic "
-                       "surface (its image meets the enclosure of g(S)), or its sheet is not identified; "
-                       "a deeper --depth may decide it")
-    elif res["in_workspace"] == "undecided":
-        res["note"] = "the box holding the pose is on the undecided layer of W or of det A = 0"
+def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool = False, as_json: bool = False,
+                figures: bool = True, certificates: bool = True, paper: bool = False,
+                refine_to: int | None = None) -> int:
+    """``intervalkin analyze`` (and ``paper`` when paper=True): the whole chain into one folder."""
+    geometry = default_geometry() if paper else geometry_from_option(geometry_path)
+    check_chain_depth(depth, refine_to)  # before the output folder is made
+    out = prepare_output_dir(out, force)
+    st = Stages(quiet=quiet)
+    a = analyse(geometry, depth, progress=st, refine_to=refine_to)
+    summary = write_chain(a, out, figures=figures, stages=st)
+    trajs = []
+    if paper:  # before the certificates, which re-check these paths
+        st.start("certified trajectories between Table 1's solutions 2, 3, 6")
+        summary["trajectories"], trajs = _paper_trajectories(a, out, summary["files"])
+        st.done()
+    if certificates:
+        st.start("certificates")
+        summary["files"] += write_analysis_certificates(a, out, trajectories=trajs)
+        st.done()
+    if paper:
+        st.start("paper report")
+        summary["timings_seconds"] = {**summary["timings_seconds"], **st.timings,
+                                      "total": time.perf_counter() - st.t0}
+        summary["files"].append(write_report(a, summary, out, st.timings))
+        st.done()
+    summary["timings_seconds"] = {**summary["timings_seconds"], **st.timings,
+                                  "total": time.perf_counter() - st.t0}
+    write_json(out / "summary.json", summary)
     if as_json:
-        sys.stdout.write(json.dumps(res) + "\n")
-    else:
-        for k in ("in_workspace", "aspect", "basic_region", "uniqueness_domain", "note"):
-            if k not in res:
-                continue
-            sys.stdout.write(f"{k:<18} {res[k]}\n")
+        sys.stdout.write(json.dumps(summary) + "\n")
+    elif not quiet:
+        sys.stdout.write(chain_table(summary) + f"\nwritten to {out}/ in {summary['timings_seconds']['total']:.1f} s\n")
     return 0
-
-
-def _label_from_npz(folder: Path, exact) -> dict:
-    """Look a pose up in the workspace.npz of an earlier ``analyze`` / ``paper`` output."""
-    from fractions import Fraction
-
-    path = folder / "pavings" / "workspace.npz"
-    try:
-        with np.load(path) as z:
-            cols = {k: z[k] for k in ("lo", "hi", "in_workspace", "det_sign", "basic_region", "uniqueness_domain")}
-    except (OSError, KeyError, ValueError) as exc:
-        raise InputError(f"--from: cannot read {str(path)!r} ({exc})") from None
-    xf = np.array([float(v) for v in exact])
-    near = np.flatnonzero(np.all((cols["lo"] <= xf + 1e-9) & (xf - 1e-9 <= cols["hi"]), axis=1))
-    hit = [i for i in near if all(Fraction(float(cols["lo"][i, j])) <= exact[j] <= Fraction(float(cols["hi"][i, j]))
-                                  for j in range(3))]
-    res = {"pose": [str(v) for v in exact], "boxes": len(hit), "in_workspace": "undecided", "aspect": "undecided",
-           "basic_region": "undecided", "uniqueness_domain": "undecided"}
-    for i in hit:
-        w = int(cols["in_workspace"][i])
-        if w != 0:
-            res["in_workspace"] = "yes" if w > 0 else "no"
-        if w > 0 and cols["det_sign"][i] != 0:
-            res["aspect"] = "WA1" if cols["det_sign"][i] > 0 else "WA2"
-        if cols["basic_region"][i] >= 0:
-            res["basic_region"] = int(cols["basic_region"][i])
-        if cols["uniqueness_domain"][i] >= 0:
-            res["uniqueness_domain"] = int(cols["uniqueness_domain"][i])
-    if res["in_workspace"] == "no":
-        res["aspect"] = res["basic_region"] = res["uniqueness_domain"] = "none (outside W)"
-    return res
 
 
 def _paper_trajectories(a: Analysis, out: Path, files: list[str]) -> tuple[list[dict], list]:
@@ -235,7 +148,6 @@ def _paper_trajectories(a: Analysis, out: Path, files: list[str]) -> tuple[list[
     Returns the report entries (one per pair, failures included) and the
     :class:`~intervalkin.space.trajectory.Trajectory` objects found (for the certificates).
     """
-
     done, found = [], []
     for i, j in ((2, 3), (2, 6), (3, 6)):
         try:
@@ -261,17 +173,14 @@ def run_trajectory(geometry_path, rho, i_from: int, i_to: int, depth: int = 7, o
     The request is checked first (solutions of different aspects are refused at
     once, before any paving).
     """
-    import json
-
-
     geometry = geometry_from_option(geometry_path)
     check_request(geometry, rho, i_from, i_to)
     check_chain_depth(depth)
     if out is not None:
-        out = prepare_output_dir(out, force=True) if Path(out).is_dir() and (Path(out) / MARKER).exists() \
-            else prepare_output_dir(out, force=False)
+        earlier = Path(out).is_dir() and (Path(out) / MARKER).exists()
+        out = prepare_output_dir(out, force=earlier)
     st = Stages(quiet=quiet or as_json)
-    a = analyse(geometry, depth, st)
+    a = analyse(geometry, depth, progress=st)
     st.start("certified path")
     traj = trajectory(geometry, rho, i_from, i_to, analysis=a.regions, joint=a.joint)
     st.done()

@@ -1,7 +1,8 @@
-"""Writers for pavings: npz, JSON and VTK, each atomic.
+"""Pavings as files: the npz columns, VTK hexahedra for ParaView, and readers for both.
 
-Every writer writes a temporary file in the destination folder and moves it in
-place with :func:`os.replace`, so a reader never sees a half-written file.
+Every writer goes through the atomic writer of :mod:`intervalkin.core.files`
+(temporary file in the destination folder, then :func:`os.replace`), so a
+reader never sees a half-written file.
 
 ``pavings/workspace.npz`` (one row per box; x, y, phi with phi in radians):
 
@@ -22,26 +23,21 @@ domain              float64     (3, 2) the paved domain
 
 from __future__ import annotations
 
+import base64
+import io
+import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Mapping
 
 import numpy as np
 
-from intervalkin.core.files import _atomic, atomic_write_bytes
-from intervalkin.paving.labels import Label
+from intervalkin.core.files import atomic_write, atomic_write_bytes
+from intervalkin.paving.labels import signed_labels
 from intervalkin.paving.tree import Paving
 
 __all__ = ['NPZ_COLUMNS', 'paving_columns', 'write_npz', 'read_npz', 'write_vtu', 'write_vtu_paving', 'read_vtu', 'write_vtk_legacy']
 
 NPZ_COLUMNS = ("lo", "hi", "depth", "in_workspace", "det_sign", "aspect")
-
-
-def _tri(label: np.ndarray) -> np.ndarray:
-    """Label -> int8: INSIDE 1, BOUNDARY 0, OUTSIDE -1."""
-    out = np.zeros(label.shape, dtype=np.int8)
-    out[label == Label.INSIDE] = 1
-    out[label == Label.OUTSIDE] = -1
-    return out
 
 
 def paving_columns(paving: Paving, aspect: np.ndarray | None = None,
@@ -52,8 +48,8 @@ def paving_columns(paving: Paving, aspect: np.ndarray | None = None,
         "lo": np.ascontiguousarray(paving.lo, dtype=np.float64),
         "hi": np.ascontiguousarray(paving.hi, dtype=np.float64),
         "depth": paving.level.astype(np.int64),
-        "in_workspace": _tri(paving.labels["W"]),
-        "det_sign": _tri(paving.labels["det_positive"]),
+        "in_workspace": signed_labels(paving.labels["W"]),
+        "det_sign": signed_labels(paving.labels["det_positive"]),
         "aspect": (np.full(n, -1, np.int32) if aspect is None else np.asarray(aspect, dtype=np.int32)),
     }
     for k, v in (extra or {}).items():
@@ -70,7 +66,7 @@ def write_npz(path, paving: Paving, aspect=None, extra=None) -> Path:
     """Write ``pavings/workspace.npz`` (compressed) with the documented columns plus ``extra``."""
     cols = paving_columns(paving, aspect, extra)
     cols["domain"] = np.asarray(paving.domain, dtype=np.float64)
-    return _atomic(Path(path), lambda f: np.savez_compressed(f, **cols))
+    return atomic_write(Path(path), lambda f: np.savez_compressed(f, **cols))
 
 
 def read_npz(path) -> dict[str, np.ndarray]:
@@ -93,8 +89,6 @@ def _hex_points(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
 
 def _b64(arr: np.ndarray) -> str:
     """Inline binary DataArray payload: base64 of (UInt64 byte count + little-endian data)."""
-    import base64
-
     data = np.ascontiguousarray(arr).tobytes()
     return base64.b64encode(np.uint64(len(data)).astype("<u8").tobytes() + data).decode("ascii")
 
@@ -165,9 +159,6 @@ def write_vtu_paving(path, paving: Paving, cell_data: Mapping[str, np.ndarray], 
 
 def read_vtu(path) -> dict[str, np.ndarray]:
     """Read back a file written by :func:`write_vtu` (points, cell types, cell data)."""
-    import base64
-    import xml.etree.ElementTree as ET
-
     dtypes = {"Float64": "<f8", "Int64": "<i8", "UInt8": "u1", "Int32": "<i4"}
     root = ET.parse(path).getroot()
     piece = root.find("UnstructuredGrid/Piece")
@@ -203,8 +194,6 @@ def write_vtk_legacy(path, lo: np.ndarray, hi: np.ndarray, cell_data: Mapping[st
 def _fmt(a: np.ndarray, fmt: str) -> str:
     if a.size == 0:
         return ""
-    import io
-
     buf = io.StringIO()
     np.savetxt(buf, a, fmt=fmt)
     return buf.getvalue()

@@ -1,24 +1,37 @@
-"""PNG renderings of a workspace paving (matplotlib, Agg backend, imported lazily).
+"""Figures of certified labels (matplotlib, Agg backend), and the one matplotlib setup of the package.
 
-* 3-D views like the paper's Figures 3 (W), 5 (singular layer) and 6 (aspects):
-  scatter of box centres (subsampled, marker size growing with the box), x, y, phi axes.
-* phi-slices: x-y images of the labels at several phi values, which read better
-  than 3-D views; each box meeting the slice paints its (x, y) rectangle.
+* Workspace paving, like the paper's Figures 3 (W), 5 (singular layer) and 6
+  (aspects): 3-D scatters of box centres (subsampled, marker size growing with
+  the box) over x, y, phi, and phi-slices, x-y images of the labels at several
+  phi values, which read better than 3-D views (each box meeting the slice
+  paints its (x, y) rectangle).
+* Joint space (Figs. 2 and 11): cells coloured by certified solution count.
+* Definition sets (Figs. 9, 10, 12, 13): characteristic surfaces, basic regions,
+  uniqueness domains, the regions above the richest joint cell.
 
 Colours: certified INSIDE boxes are solid, the undecided layer is grey or orange.
 The figures are pictures of certified labels, not certificates themselves.
+
+:func:`pyplot` selects the Agg backend before pyplot is imported (matplotlib is
+imported on first use only); :func:`save_png` writes a figure atomically through
+:mod:`intervalkin.core.files`.  The trajectory figures
+(:mod:`intervalkin.app.animation`) use both.
 """
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
 
+from intervalkin.core.files import atomic_write_bytes
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
+from intervalkin.space.singular_surface import may_be_singular
 
-__all__ = ['render_3d', 'slice_image', 'render_slices', 'render_all']
+__all__ = ['pyplot', 'save_png', 'render_3d', 'slice_image', 'render_slices', 'render_all', 'render_joint',
+           'render_ids_3d', 'render_ids_slices', 'render_regions']
 
 _WA1 = "#1f77b4"
 _WA2 = "#d62728"
@@ -26,13 +39,21 @@ _W = "#2ca02c"
 _UND = "#ff9f1c"
 
 
-def _plt():
+def pyplot():
+    """matplotlib.pyplot on the Agg backend (no display needed)."""
     import matplotlib
 
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def save_png(fig, path, dpi="figure") -> Path:
+    """Write ``fig`` as a PNG to ``path`` atomically (at the figure's own dpi unless given); returns the path."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    return atomic_write_bytes(path, buf.getvalue())
 
 
 def _subsample(idx: np.ndarray, limit: int, rng) -> np.ndarray:
@@ -43,7 +64,7 @@ def _subsample(idx: np.ndarray, limit: int, rng) -> np.ndarray:
 
 def render_3d(paving: Paving, layers, path, title: str, max_points: int = 40000, seed: int = 0):
     """Scatter of box centres in (x, y, phi) for each (mask, colour, name) layer; one PNG."""
-    plt = _plt()
+    plt = pyplot()
     rng = np.random.default_rng(seed)
     fig = plt.figure(figsize=(7.5, 6.5), dpi=110)
     ax = fig.add_subplot(projection="3d")
@@ -71,9 +92,9 @@ def render_3d(paving: Paving, layers, path, title: str, max_points: int = 40000,
     else:
         ax.text2D(0.05, 0.95, "no certified box at this depth", transform=ax.transAxes, fontsize=9)
     fig.tight_layout()
-    fig.savefig(path)
+    written = save_png(fig, path)
     plt.close(fig)
-    return Path(path)
+    return written
 
 
 def slice_image(paving: Paving, phi: float, codes: np.ndarray, resolution: int = 256) -> np.ndarray:
@@ -112,7 +133,7 @@ def slice_image(paving: Paving, phi: float, codes: np.ndarray, resolution: int =
 def render_slices(paving: Paving, codes: np.ndarray, palette, names, path, title: str,
                   phis=None, resolution: int = 256, base=None):
     """A grid of x-y slices at several phi values; ``codes`` index ``palette`` (0..k-1)."""
-    plt = _plt()
+    plt = pyplot()
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
@@ -141,9 +162,9 @@ def render_slices(paving: Paving, codes: np.ndarray, palette, names, path, title
     fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=8 if rows > 1 else 9, frameon=False)
     fig.suptitle(title, fontsize=11)
     fig.tight_layout(rect=(0, 0.03 + 0.03 * rows, 1, 0.96), h_pad=1.6)
-    fig.savefig(path)
+    written = save_png(fig, path)
     plt.close(fig)
-    return Path(path)
+    return written
 
 
 def render_all(paving: Paving, out_dir, max_points: int = 40000, base=None) -> list[Path]:
@@ -151,21 +172,20 @@ def render_all(paving: Paving, out_dir, max_points: int = 40000, base=None) -> l
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     W = paving.labels["W"]
-    D = paving.labels["det_positive"]
     wa1 = paving.labels["WA1"] == Label.INSIDE
     wa2 = paving.labels["WA2"] == Label.INSIDE
     w_in = W == Label.INSIDE
     w_bd = W == Label.BOUNDARY
-    sing = (W != Label.OUTSIDE) & (D == Label.BOUNDARY)
+    sing = may_be_singular(paving.labels)
     files = [
         render_3d(paving, [(w_in, _W, "W (certified)")], out / "workspace_3d.png",
                   f"Workspace W, certified boxes (depth {paving.depth}; cf. paper Fig. 3)", max_points),
         render_3d(paving, [(sing & w_in, "#444444", "det A = 0 may occur, in W"),
                            (sing & w_bd, _UND, "... on W's undecided boundary")],
                   out / "singular_3d.png",
-                  f"Type-2 singular layer (det A undecided; cf. paper Fig. 5)", max_points),
+                  "Type-2 singular layer (det A undecided; cf. paper Fig. 5)", max_points),
         render_3d(paving, [(wa1, _WA1, "WA1: det A > 0"), (wa2, _WA2, "WA2: det A < 0")],
-                  out / "aspects_3d.png", f"Aspects, certified boxes (cf. paper Fig. 6)", max_points),
+                  out / "aspects_3d.png", "Aspects, certified boxes (cf. paper Fig. 6)", max_points),
     ]
     # slices: W / undecided; aspects / singular / undecided
     codes_w = np.where(w_in, 0, np.where(w_bd, 1, -1)).astype(np.int16)
@@ -190,7 +210,7 @@ _COUNT_COLOURS = {0: "#dddddd", 2: "#8ecae6", 4: "#ffb703", 6: "#d62828"}
 
 
 def _palette(k: int) -> list[str]:
-    plt = _plt()
+    plt = pyplot()
     cmaps = [plt.get_cmap("tab20"), plt.get_cmap("tab20b"), plt.get_cmap("tab20c")]
     colours = []
     for cm in cmaps:
@@ -202,7 +222,7 @@ def _palette(k: int) -> list[str]:
 
 def render_joint(joint, out_dir, max_points: int = 60000, seed: int = 0) -> list[Path]:
     """Joint-space cells coloured by certified solution count: a 3-D view and rho3-slices."""
-    plt = _plt()
+    plt = pyplot()
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
@@ -229,8 +249,7 @@ def render_joint(joint, out_dir, max_points: int = 60000, seed: int = 0) -> list
     for h in leg.legend_handles:
         h.set_alpha(1)
     fig.tight_layout()
-    p3 = out / "joint_3d.png"
-    fig.savefig(p3)
+    p3 = save_png(fig, out / "joint_3d.png")
     plt.close(fig)
 
     n = joint.n
@@ -242,8 +261,7 @@ def render_joint(joint, out_dir, max_points: int = 60000, seed: int = 0) -> list
     names = ["may meet g(S)", "0 solutions", "2 solutions", "4 solutions", "6 solutions"]
     ks = np.linspace(0, n - 1, 8).round().astype(int)
     fig, axes = plt.subplots(2, 4, figsize=(13, 7.4), dpi=100)
-    r0 = [float(v) for v in joint.rho_min]
-    h = [float(v) for v in joint.step]
+    r0, h = joint.approx_grid()
     ext = (r0[0], r0[0] + n * h[0], r0[1], r0[1] + n * h[1])
     for a, kk in zip(axes.ravel(), ks):
         a.imshow(codes[:, :, kk].T, origin="lower", cmap=ListedColormap(palette), vmin=0, vmax=4,
@@ -256,8 +274,7 @@ def render_joint(joint, out_dir, max_points: int = 60000, seed: int = 0) -> list
                fontsize=9, frameon=False)
     fig.suptitle("Joint space, rho3-slices: certified solution count per voxel", fontsize=11)
     fig.tight_layout(rect=(0, 0.05, 1, 0.96))
-    ps = out / "joint_slices.png"
-    fig.savefig(ps)
+    ps = save_png(fig, out / "joint_slices.png")
     plt.close(fig)
     return [p3, ps]
 
@@ -289,14 +306,14 @@ def render_ids_slices(paving: Paving, ids: np.ndarray, path, title: str, names=N
 
 
 def render_regions(analysis, out_dir, base=None) -> list[Path]:
-    """The paper's Figures 9, 10, 12 and 13 from a :class:`regions.RegionAnalysis`."""
+    """The paper's Figures 9, 10, 12 and 13 from a :class:`~intervalkin.space.basic_region.RegionAnalysis`."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     p = analysis.paving
     files = []
     in_aspect = (p.labels["WA1"] == Label.INSIDE) | (p.labels["WA2"] == Label.INSIDE)
     sc = in_aspect & (p.labels["off_Sc"] != Label.INSIDE)
-    sing = (p.labels["W"] != Label.OUTSIDE) & (p.labels["det_positive"] == Label.BOUNDARY)
+    sing = may_be_singular(p.labels)
     codes = np.full(len(p), -1, np.int16)
     codes[(p.labels["WA1"] == Label.INSIDE) & ~sc] = 0
     codes[(p.labels["WA2"] == Label.INSIDE) & ~sc] = 1
@@ -315,7 +332,7 @@ def render_regions(analysis, out_dir, base=None) -> list[Path]:
                                    f"{len(analysis.regions)} basic regions (cf. paper Fig. 10)", names,
                                    extra=(sc, "#eeeeee", "undecided"), base=base))
     files.append(render_ids_3d(p, analysis.region, out / "basic_regions_3d.png",
-                               f"Basic regions (cf. paper Fig. 10)", names))
+                               "Basic regions (cf. paper Fig. 10)", names))
     dnames = [f"domain {i}" for i in range(len(analysis.domains))]
     files.append(render_ids_slices(p, analysis.domain, out / "uniqueness_domains_slices.png",
                                    f"{len(analysis.domains)} uniqueness domains (cf. paper Fig. 12)", dnames,

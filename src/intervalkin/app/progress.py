@@ -1,20 +1,20 @@
-"""The whole workspace chain for one geometry, writing one output folder.
+"""Progress on stderr for the command line: stage lines with times, and a bar per paving level.
 
-``run_pave`` (the ``intervalkin pave`` command) paves W, the sign of det A and the
-aspects, finds the aspects as connected components, and writes::
-
-    DIR/pavings/workspace.npz    boxes and labels (format: intervalkin.app.export)
-    DIR/pavings/workspace.vtu    the same as a VTK unstructured grid of hexahedra
-    DIR/figures/*.png            3-D views and phi-slices
-    DIR/summary.json             counts, volumes, components, timings, what is certified
+The library never prints; :func:`intervalkin.pipeline.analyse` reports its stages
+to a callback.  :class:`Stages` is that callback for the ``intervalkin`` command
+(it also times the command's own stages: writing files, figures, certificates),
+and :class:`ProgressBar` draws one paver's levels.
 """
 
 from __future__ import annotations
 
 import sys
 import time
+from typing import Mapping
 
-__all__ = ['ProgressBar']
+from intervalkin.pipeline import ProgressEvent
+
+__all__ = ['ProgressBar', 'Stages']
 
 
 class ProgressBar:
@@ -25,7 +25,7 @@ class ProgressBar:
         self.width = width
         self.t0 = time.perf_counter()
 
-    def __call__(self, st: dict) -> None:
+    def __call__(self, st: Mapping) -> None:
         done = (st["level"] + 1) / (st["depth"] + 1)
         n = int(round(done * self.width))
         self.stream.write(
@@ -38,7 +38,7 @@ class ProgressBar:
 
 
 class Stages:
-    """Stage names and timings on stderr (silent when quiet)."""
+    """Stage names and timings on stderr (silent when quiet); a progress callback for the library."""
 
     def __init__(self, quiet: bool = False, stream=None):
         self.quiet = quiet
@@ -47,9 +47,11 @@ class Stages:
         self.timings: dict[str, float] = {}
         self._name = None
         self._start = 0.0
+        self._bar: ProgressBar | None = None
 
     def start(self, name: str) -> None:
         self._name, self._start = name, time.perf_counter()
+        self._bar = None if self.quiet else ProgressBar(self.stream)
         if not self.quiet:
             self.stream.write(f"[{time.perf_counter() - self.t0:6.1f} s] {name} ...\n")
             self.stream.flush()
@@ -57,5 +59,11 @@ class Stages:
     def done(self) -> None:
         self.timings[self._name] = time.perf_counter() - self._start
 
-    def bar(self):
-        return None if self.quiet else ProgressBar(self.stream)
+    def __call__(self, event: ProgressEvent) -> None:
+        """Follow a library run: a line per stage, a bar per paving."""
+        if event.kind == "start":
+            self.start(event.stage)
+        elif event.kind == "level" and self._bar is not None and event.level is not None:
+            self._bar(event.level)
+        elif event.kind == "done":
+            self.done()

@@ -1,16 +1,12 @@
-"""The paper's published numbers, regenerated with certificates and compared.
+"""``report.md`` of ``intervalkin paper``: each claim of the paper beside the certified result.
 
-Wenger & Chablat (1997), section 3.2, eq. (11) and Table 1: for the joint vector
-rho = (14.98, 15.38, 12.0) the direct kinematic problem of the paper's 3-RPR has
-six real solutions, and solutions 2, 3 and 6 lie in the same aspect (WA1, det A > 0
-with the sign convention of DESIGN.md section 2).
-
-The paper printed its rows with three decimals from inexact numerics: put back
-into the inverse kinematics they miss the prescribed leg lengths by up to about
-0.02 (0.01 typically).  The certified solutions of :func:`intervalkin.solve.dkp.solve`
-are exact up to their enclosure width (< 1e-9); the comparison reports both the
-distance from each paper row to its certified solution and the paper row's own
-residual in rho, so that the two sources of difference can be told apart.
+Wenger & Chablat (1997) claim: six solutions of Table 1's joint vector, three
+of them in one aspect; two aspects; joint-space domains with 2, 4 and 6
+solutions; 28 basic regions; 6 uniqueness domains; non-singular paths between
+solutions 2, 3 and 6.  The report sets each claim beside what the run
+certified, with its status (certified, or a certified lower bound and why no
+more is proved), the figures, and the undecided volumes and timings.  It only
+formats: every number comes from the analysis and its summary.json.
 """
 
 from __future__ import annotations
@@ -21,10 +17,8 @@ import numpy as np
 
 from intervalkin.app.table1 import table1_comparison
 from intervalkin.core.files import atomic_write_bytes
+from intervalkin.pipeline import Analysis
 
-# --------------------------------------------------------------------------------------
-# The report of `intervalkin paper`
-# --------------------------------------------------------------------------------------
 #: The paper's counts (sections 3.1, 5.1, 5.2).
 PAPER_COUNTS = {"aspects": 2, "basic_regions": 28, "uniqueness_domains": 6}
 
@@ -40,7 +34,7 @@ def _fig(name: str, caption: str, files: list[str]) -> str:
     return f"![{caption}]({path})\n\n*{caption}*\n" if path in files else f"*(figure {name} not written)*\n"
 
 
-def write_report(analysis, summary: dict, out, timings: dict) -> str:
+def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
     """Write ``report.md``: each claim of the paper beside the certified result. Returns its name."""
 
     comp = table1_comparison(analysis.geometry)
@@ -203,9 +197,9 @@ def write_report(analysis, summary: dict, out, timings: dict) -> str:
     u = summary["undecided_volume"]
     a(f"- undecided volume: W {u['W']:.1f}, WA1 {u['WA1']:.1f}, WA2 {u['WA2']:.1f}; characteristic layer "
       f"{summary['characteristic_layer_volume']:.1f}")
-    for h in getattr(analysis, "refinement", ()):
-        a(f"- regions at depth {h['depth']}: {h['basic_regions']} basic regions, Proposition 1 seen in full: "
-          f"{'yes' if h['consistent'] else 'no'}" + (f" ({h['stopped']})" if "stopped" in h else ""))
+    for h in analysis.refinement:
+        a(f"- regions at depth {h.depth}: {h.basic_regions} basic regions, Proposition 1 seen in full: "
+          f"{'yes' if h.consistent else 'no'}" + (f" ({h.stopped})" if h.stopped else ""))
     a("\nA deeper run (`intervalkin paper --depth 9`) thins every undecided layer by about half; "
       "`--refine-to 9` deepens only the regions paving, and only while Proposition 1 is not seen in full.\n")
     atomic_write_bytes(Path(out) / "report.md", ("\n".join(L) + "\n").encode())

@@ -1,12 +1,10 @@
-"""The whole workspace chain for one geometry, writing one output folder.
+"""summary.json and the terminal tables: the counts with their status, volumes, cells, timings.
 
-``run_pave`` (the ``intervalkin pave`` command) paves W, the sign of det A and the
-aspects, finds the aspects as connected components, and writes::
-
-    DIR/pavings/workspace.npz    boxes and labels (format: intervalkin.app.export)
-    DIR/pavings/workspace.vtu    the same as a VTK unstructured grid of hexahedra
-    DIR/figures/*.png            3-D views and phi-slices
-    DIR/summary.json             counts, volumes, components, timings, what is certified
+The documents are built from the library's typed results; the keys are the
+output contract (README "Output files").  Each count block carries "count",
+"exact", "lower_bound", "upper_bound" (null: none proved) and "why"
+(:meth:`intervalkin.core.status.Count.to_json`), and ``certified`` spells out
+what the labels, volumes and components prove.
 """
 
 from __future__ import annotations
@@ -16,8 +14,9 @@ import numpy as np
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 from intervalkin.pipeline import Analysis
+from intervalkin.space.joint_space import JointPaving
 
-__all__ = ['CERTIFIED_NOTE', 'pave_summary', 'chain_summary']
+__all__ = ['CERTIFIED_NOTE', 'pave_summary', 'pave_table', 'joint_summary', 'joint_table', 'chain_summary', 'chain_table']
 
 CERTIFIED_NOTE = {
     "labels": "Every INSIDE / OUTSIDE box label is proved with outward-rounded interval arithmetic "
@@ -69,7 +68,8 @@ def pave_summary(paving: Paving, info: list[dict], timings: dict) -> dict:
     }
 
 
-def _table(summary: dict) -> str:
+def pave_table(summary: dict) -> str:
+    """A short terminal table of a workspace paving: volumes per label, components, time."""
     rows = [f"{'set':<6}{'inside':>12}{'undecided':>12}{'outside':>12}   (volume, x*y*phi)"]
     for name in ("W", "WA1", "WA2"):
         v = summary[name]["volume"]
@@ -84,7 +84,7 @@ def _table(summary: dict) -> str:
     return "\n".join(rows)
 
 
-def joint_summary(jp) -> dict:
+def joint_summary(jp: JointPaving) -> dict:
     """The joint-space part of summary.json."""
     return {
         "depth": jp.depth,
@@ -108,8 +108,7 @@ def chain_summary(a: Analysis) -> dict:
     """summary.json of the whole chain (counts with their certification status first)."""
     ra = a.regions
     p = ra.paving
-    counts = ra.counts()
-    out = dict(counts)
+    out = ra.counts().to_json()
     out.update(
         {
             "geometry": a.geometry.name,
@@ -132,7 +131,7 @@ def chain_summary(a: Analysis) -> dict:
                            & (p.labels["off_Sc"] != Label.INSIDE)].sum()
             ),
             "timings_seconds": a.timings,
-            "refinement": list(a.refinement),
+            "refinement": [step.to_json() for step in a.refinement],
             "certified": CERTIFIED_NOTE,
         }
     )
@@ -166,7 +165,8 @@ def chain_table(summary: dict) -> str:
     return "\n".join(rows)
 
 
-def joint_table(jp) -> str:
+def joint_table(jp: JointPaving) -> str:
+    """A terminal table of the joint cells: count, aspect split, size, witness."""
     rows = [f"{'cell':>5}{'count':>7}{'WA1':>5}{'WA2':>5}{'voxels':>10}{'volume':>11}{'share':>8}   witness rho"]
     for c in jp.cells:
         if c.n_voxels < 2 and len(jp.cells) > 40:

@@ -1,4 +1,4 @@
-"""The paper's published numbers, regenerated with certificates and compared.
+"""Table 1 of the paper beside the certified solutions of its joint vector (``intervalkin table1``).
 
 Wenger & Chablat (1997), section 3.2, eq. (11) and Table 1: for the joint vector
 rho = (14.98, 15.38, 12.0) the direct kinematic problem of the paper's 3-RPR has

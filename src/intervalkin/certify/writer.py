@@ -1,8 +1,11 @@
-"""Certificate files: each claim intervalkin makes, with the evidence a sceptic needs.
+"""The certificate folder: each claim intervalkin makes, with the evidence a sceptic needs.
 
-The writers here turn the library's results into JSON files; the independent
-checker (:mod:`intervalkin.checker`, ``intervalkin verify DIR``) re-proves them
-from the files alone with arb, without the paving, region or solver code.
+:func:`write_certificates` turns the library's results into JSON files (the
+claims are built by :mod:`~intervalkin.certify.solve_claims` and
+:mod:`~intervalkin.certify.workspace_claims`); the independent checker
+(:mod:`intervalkin.checker`, ``intervalkin verify DIR``) re-proves them from the
+files alone with arb, without the paving, region or solver code.  This module
+holds the specification of the format.
 
 Schema (format ``"intervalkin-certificate"``, version 1)
 -------------------------------------------------------
@@ -67,7 +70,7 @@ Claim fields by kind (``id`` is unique within its file):
     2 pi phi_turns: phi is unwrapped along the path), ``waypoints`` (m rows
     [x, y, phi] as hex strings, for the reader) and ``segments``:
     ``[{"start", "end", "pieces"}]`` exactly as
-    :meth:`~intervalkin.space.trajectory.Trajectory.certificate` gives them: end point
+    :meth:`~intervalkin.space.trajectory_result.Trajectory.certificate` gives them: end point
     enclosures ``[[lo, hi]] * 3`` and pieces ``[[t0, t1], ...]``, every number a
     binary64 written EXACTLY as a hex string (``float.hex``).  Proves: the
     straight segments, each from any point of its start enclosure to any point
@@ -87,50 +90,27 @@ with the reason (it is never written as if it held).
 
 from __future__ import annotations
 
-import json
-import os
-import tempfile
 from pathlib import Path
 from typing import Sequence
 
-from intervalkin import checker
-from intervalkin.certify.claims import (
-    FORMAT,
-    VERSION,
+from intervalkin.certify.solve_claims import (
+    dkp_claim,
+    joint_cell_claims,
+    trajectory_claims,
+)
+from intervalkin.certify.workspace_claims import (
     aspect_distinct_claims,
     box_labels_claim,
     counts_claims,
-    dkp_claim,
-    joint_cell_claims,
     region_distinct_claims,
-    trajectory_claims,
 )
+from intervalkin.checker import FORMAT, INDEX, KINDS, VERSION
 from intervalkin.core.errors import InputError
+from intervalkin.core.files import write_json
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.version import __version__
 
 __all__ = ['write_certificates']
-
-
-# --------------------------------------------------------------------------------------
-# Writing
-# --------------------------------------------------------------------------------------
-def _write_atomic(path: Path, doc: dict) -> None:
-    """JSON to ``path`` through a temporary file in the same folder and os.replace."""
-    text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
 
 
 def write_certificates(
@@ -152,7 +132,7 @@ def write_certificates(
     ----------
     out_dir : folder, created if needed.
     geometry : the manipulator the results are about.
-    dkp_results : :class:`~intervalkin.solve.dkp.DkpResult` objects -> ``dkp.json``.
+    dkp_results : :class:`~intervalkin.solve.solutions.DkpResult` objects -> ``dkp.json``.
     joint : :class:`~intervalkin.space.joint_space.JointPaving` -> ``joint_cell.json`` (each
         certified cell's witness is re-solved).
     regions : :class:`~intervalkin.space.basic_region.RegionAnalysis` -> ``aspect_distinct``,
@@ -161,7 +141,7 @@ def write_certificates(
         when ``regions`` is None.
     box_sample : number of boxes in the ``box_labels`` sample (0: no sample).
     seed : seed of the sample (:func:`intervalkin.checker.sample_indices`).
-    trajectories : :class:`~intervalkin.space.trajectory.Trajectory` objects ->
+    trajectories : :class:`~intervalkin.space.trajectory_result.Trajectory` objects ->
         ``trajectory.json`` (uncertified ones are omitted).
     precision : arb bits the checker starts with (raised per claim when needed).
 
@@ -169,9 +149,7 @@ def write_certificates(
     is written; refused ones are listed under ``omitted`` in ``index.json``.
     Each file is written atomically; ``index.json`` is written last.
     """
-
     if isinstance(box_sample, bool) or not isinstance(box_sample, int) or box_sample < 0:
-
         raise InputError(f"box_sample: expected an integer >= 0, got {box_sample!r}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -211,13 +189,12 @@ def write_certificates(
         files["counts"] = counts_claims(regions, aspect_refs, solve_refs)
 
     written = []
-    for kind in checker.KINDS:
+    for kind in KINDS:
         if kind not in files:
             continue
-        path = out / f"{kind}.json"
-        _write_atomic(path, {"format": FORMAT, "version": VERSION, "kind": kind, "geometry_toml": toml,
-                             "precision": precision, "claims": files[kind]})
-        written.append(path)
+        written.append(write_json(out / f"{kind}.json", {
+            "format": FORMAT, "version": VERSION, "kind": kind, "geometry_toml": toml,
+            "precision": precision, "claims": files[kind]}, indent=1))
     index = {
         "format": FORMAT,
         "version": VERSION,
@@ -228,6 +205,5 @@ def write_certificates(
         "omitted": omitted,
         "how_to_check": "intervalkin verify DIR (or intervalkin.checker.verify_directory(DIR))",
     }
-    _write_atomic(out / checker.INDEX, index)
-    written.append(out / checker.INDEX)
+    written.append(write_json(out / INDEX, index, indent=1))
     return written

@@ -1,23 +1,34 @@
 """The independent checker of intervalkin certificate files (``intervalkin verify DIR``).
 
 A certificate folder (written by :func:`intervalkin.certify.writer.write_certificates`;
-schema in that module) states claims with their evidence.  This module re-proves
+schema in that module) states claims with their evidence.  This package re-proves
 every claim from the files alone, in arb ball arithmetic (python-flint), and
-prints one line per claim.  Its trusted base is small on purpose:
+gives one verdict per claim.  Its trusted base is small on purpose:
 
 * the Python standard library and python-flint (arb, acb, arb_poly, acb_poly,
   arb_mat; ``acb_poly.roots`` for certified complex root isolation);
 * :mod:`intervalkin.core.geometry` (reads the geometry TOML stored in the files as
   exact decimals; constants as exact rationals and surds) and
   :mod:`intervalkin.core.errors`;
-* the few formulas written out below (rho_i^2, det A, F, F', the reduced
-  sextic), re-derived here on purpose instead of imported from
-  :mod:`intervalkin.kinematics` or :mod:`intervalkin.solve.dkp`.
+* its own model of the manipulator in arb (rho_i^2, det A, F, F' in
+  :mod:`~intervalkin.checker.model`, the reduced sextic in
+  :mod:`~intervalkin.checker.solutions`).  These formulas are written a second
+  time on purpose, from the mathematics, instead of imported from
+  :mod:`intervalkin.kinematics` or :mod:`intervalkin.solve`: the checker must
+  stay independent of what it checks, and the tests compare the two writings.
 
-It never imports the paving, predicate, joint, region, dkp or analysis code
-(``tests/test_certificates.py::test_checker_imports_none_of_the_checked_modules``).
+It never imports the kinematics, paving, solver, space, certify or app code,
+nor numpy (the import-linter contract in ``pyproject.toml``,
+``tests/test_architecture.py`` and
+``tests/test_certificates.py::test_checker_imports_none_of_the_checked_modules``).
 What each claim type proves, and what it still trusts, is in
 ``proofs/lemma-checker.md``.
+
+Modules: :mod:`~intervalkin.checker.parse` (reading fields exactly),
+:mod:`~intervalkin.checker.model` (the arb model), :mod:`~intervalkin.checker.labels`
+(box labels), :mod:`~intervalkin.checker.solutions` (direct kinematics),
+:mod:`~intervalkin.checker.trajectory` (motions), :mod:`~intervalkin.checker.claims`
+(one check per kind, counts), :mod:`~intervalkin.checker.folder` (a whole folder).
 
 Re-proved per claim type
 ------------------------
@@ -56,19 +67,29 @@ Re-proved per claim type
     the segment's end enclosures), the ball A + [t0, t1] (B - A) is formed in
     arb and det A is proved of the aspect's sign and rho_min_i^2 <= rho_i^2 <=
     rho_max_i^2 proved on it (the t range bisected while undecided, within
-    :data:`PIECE_BUDGET`); the pieces tile [0, 1]; consecutive segments share
-    their end enclosure; the start enclosure lies in the first segment's
-    start, and the goal enclosure shifted by 2 pi phi_turns (phi unwrapped)
-    in the last segment's end.
+    :data:`~intervalkin.checker.trajectory.PIECE_BUDGET` evaluations); the
+    pieces tile [0, 1]; consecutive segments share their end enclosure; the
+    start enclosure lies in the first segment's start, and the goal enclosure
+    shifted by 2 pi phi_turns (phi unwrapped) in the last segment's end.
 ``counts``
     Each declared lower bound is recomputed from the referenced claims that
-    verified (rules in :func:`_count_bound`); a declared lower bound larger than
-    the recomputed one, or a count declared exact, is refused.
+    verified (rules in :func:`~intervalkin.checker.claims.count_bound`); a
+    declared lower bound larger than the recomputed one, or a count declared
+    exact, is refused.
 """
 
-from intervalkin.checker.claims import box_label_proved, check_claim
+from intervalkin.checker.claims import check_claim
 from intervalkin.checker.folder import CheckResult, verify_directory
-from intervalkin.checker.parse import FORMAT, INDEX, KINDS, VERSION, CertificateFormatError, parse_exact, sample_indices
+from intervalkin.checker.labels import box_label_proved
+from intervalkin.checker.parse import (
+    FORMAT,
+    INDEX,
+    KINDS,
+    VERSION,
+    CertificateFormatError,
+    parse_exact,
+    sample_indices,
+)
 
 __all__ = [
     "FORMAT",

@@ -1,4 +1,4 @@
-"""Errors raised by intervalkin.
+"""Errors raised by intervalkin: one base class, one subclass per kind.
 
 Every error a user can provoke (bad input, an impossible request) derives from
 :class:`IntervalkinError`; the command line catches that base class, prints its
@@ -21,5 +21,14 @@ class InputError(IntervalkinError):
     """A value given by the user (joint vector, depth, path) is not acceptable."""
 
 
+class CertificateFormatError(InputError):
+    """A certificate folder is missing, unreadable or not in the documented format."""
+
+
 class ResourceError(IntervalkinError):
     """A request would exceed what the machine can give (memory, depth)."""
+
+
+class NoPathError(IntervalkinError):
+    """No non-singular motion can be given: the two assembly modes are in different aspects
+    (then none exists), or none was found through the certified boxes (not a proof that none exists)."""

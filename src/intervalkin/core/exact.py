@@ -1,55 +1,61 @@
-"""Vectorized interval arithmetic over numpy, rounded outward, and the bridge to arb.
+"""Exact numbers to float bounds: the scalar half of the rounding layer, standard library only.
 
-An :class:`Interval` holds two float64 arrays ``lo`` and ``hi`` of one shape: the
-k-th entry encloses the real interval [lo[k], hi[k]].  Every operation returns an
-enclosure of the exact range of the operation over its operands (the inclusion
-property), with rounding errors accounted for:
+The geometry is data read as exact decimals (:class:`fractions.Fraction`, square
+roots of rationals) and the trusted arithmetic is arb; float64 intervals enter the
+vectorized code through the two functions here.  Both return a pair of floats
+(lo, hi) with lo <= v <= hi for the exact value v:
 
-* ``+ - * /`` and ``sqrt`` are correctly rounded in IEEE 754 (round to nearest),
-  so the exact result lies within half an ulp of the float result; moving the
-  float result one ulp outward (``np.nextafter`` toward -inf / +inf) encloses it.
-  This module is the only place that rounds (proofs/lemma-outward-rounding.md).
-* ``cos`` and ``sin`` of numpy are not correctly rounded.  We rely on the bound
-  ``|fl(cos t) - cos t| <= TRIG_ABS_ERROR`` (and the same for sin) for
-  ``|t| <= TRIG_MAX_ARG``, a bound over 60 times the worst case observed (5.6e-17, a quarter of an ulp of 1)
-  and checked against arb on many thousands of arguments by
-  ``tests/test_interval.py::test_trig_error_bound`` (proofs/lemma-trig-enclosure.md).
-  Whether an interval holds an extremum of cos or sin is decided with an
-  enclosure [PI_LO, PI_HI] of pi, conservatively (a possible extremum is included).
+* :func:`fraction_bounds`: ``float(q)`` is the float nearest to q (Python rounds
+  int / int correctly), so q lies between it and its neighbour on the side the
+  exact comparison ``Fraction(float(q))`` vs q says; when q is a float the pair
+  is degenerate.  The result is as tight as float64 allows (at most one ulp wide).
+* :func:`arb_to_bounds`: the end points of an arb ball are exact binary numbers;
+  their conversion to float is within one ulp, so one ulp further out (one
+  ``math.nextafter`` step) is an enclosure.  A non-finite ball gives (-inf, inf).
 
-Interval comparisons never return a bare bool meaning "true": use
-:func:`certainly_positive` and friends, where False means "not proved".
+This module imports neither numpy nor flint (an arb ball is only asked for its
+end points), so the geometry parser and the independent checker can use it.  The
+array half of the rounding layer is :mod:`intervalkin.core.interval`; nothing
+else in the package moves a float by an ulp (proofs/lemma-outward-rounding.md).
 """
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
-
-import numpy as np
 
 __all__ = ['fraction_bounds', 'arb_to_bounds']
 
 
-# --- exact numbers and arb ---------------------------------------------------------------
 def fraction_bounds(q: Fraction) -> tuple[float, float]:
-    """Floats lo <= q <= hi, as tight as float64 allows."""
-    f = float(q)  # correctly rounded
+    """Floats lo <= q <= hi, one ulp apart at most (equal when q is a float).
+
+    Examples
+    --------
+    >>> fraction_bounds(Fraction(1, 2))
+    (0.5, 0.5)
+    >>> lo, hi = fraction_bounds(Fraction(1, 10))
+    >>> Fraction(lo) < Fraction(1, 10) < Fraction(hi), math.nextafter(lo, math.inf) == hi
+    (True, True)
+    """
+    q = Fraction(q)
+    f = float(q)  # correctly rounded to nearest
     fq = Fraction(f)
     if fq == q:
         return f, f
     if fq < q:
-        return f, float(np.nextafter(f, np.inf))
-    return float(np.nextafter(f, -np.inf)), f
+        return f, math.nextafter(f, math.inf)
+    return math.nextafter(f, -math.inf), f
 
 
 def arb_to_bounds(x) -> tuple[float, float]:
     """Floats lo <= every point of the arb ball x <= hi.
 
-    ``x.lower()`` and ``x.upper()`` are exact; their conversion to float is within
-    one ulp, so one more ulp outward is an enclosure.
+    ``x.lower()`` and ``x.upper()`` are exact; their conversion to float is
+    within one ulp, so one more ulp outward is an enclosure.
     """
     if not x.is_finite():
-        return -np.inf, np.inf
-    lo = float(np.nextafter(float(x.lower()), -np.inf))
-    hi = float(np.nextafter(float(x.upper()), np.inf))
+        return -math.inf, math.inf
+    lo = math.nextafter(float(x.lower()), -math.inf)
+    hi = math.nextafter(float(x.upper()), math.inf)
     return lo, hi

@@ -1,23 +1,14 @@
-"""Writers for pavings: npz, JSON and VTK, each atomic.
+"""Atomic file writing: the one way intervalkin puts a file on disk.
 
-Every writer writes a temporary file in the destination folder and moves it in
-place with :func:`os.replace`, so a reader never sees a half-written file.
+A writer fills a temporary file in the destination folder, flushes it to the
+disk, gives it the permissions a plain ``open`` would (``0o666`` less the
+umask) and moves it in place with :func:`os.replace`, which is atomic within a
+file system.  A reader (or a second run) therefore sees either the old file or
+the complete new one, never a half-written file; on any error the temporary
+file is removed and the destination is left as it was.
 
-``pavings/workspace.npz`` (one row per box; x, y, phi with phi in radians):
-
-==================  ==========  ==========================================================
-array               dtype       meaning
-==================  ==========  ==========================================================
-lo, hi              float64     (n, 3) box bounds (x, y, phi)
-depth               int64       (n,) octree level of the box (leaf width = domain / 2**depth)
-in_workspace        int8        1 certified in W, 0 undecided, -1 certified outside W
-det_sign            int8        1 det A > 0 on the box, -1 det A < 0, 0 undecided (or not
-                                evaluated: boxes certified outside W)
-aspect              int32       component id of the certified aspect box, -1 for none
-domain              float64     (3, 2) the paved domain
-(extra columns)     any         e.g. ``basic_region``, ``uniqueness_domain`` (n,), added
-                                by later stages through ``extra``
-==================  ==========  ==========================================================
+Every output of the package goes through here: pavings (npz, VTK), JSON
+summaries, certificate files, reports, figures and the trajectory animation.
 """
 
 from __future__ import annotations
@@ -26,11 +17,17 @@ import json
 import os
 import tempfile
 from pathlib import Path
+from typing import IO, Any, Callable
 
-__all__ = ['atomic_write_bytes', 'write_json']
+__all__ = ['atomic_write', 'atomic_write_bytes', 'write_json']
 
 
-def _atomic(path: Path, write) -> Path:
+def atomic_write(path, write: Callable[[IO[bytes]], Any]) -> Path:
+    """Create ``path`` (and its folder) from ``write(f)``, ``f`` a binary file object; atomic.
+
+    Returns the path written.  Whatever ``write`` raises propagates, after the
+    temporary file is removed.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -53,11 +50,11 @@ def _atomic(path: Path, write) -> Path:
 
 
 def atomic_write_bytes(path, data: bytes) -> Path:
-    """Write ``data`` to ``path`` atomically (temp file in the same folder, then os.replace)."""
-    return _atomic(Path(path), lambda f: f.write(data))
+    """Write ``data`` to ``path`` atomically; returns the path."""
+    return atomic_write(path, lambda f: f.write(data))
 
 
-def write_json(path, obj) -> Path:
-    """Write a JSON document (indented, sorted keys off, trailing newline), atomically."""
-    data = (json.dumps(obj, indent=2, allow_nan=False) + "\n").encode()
+def write_json(path, obj, indent: int = 2) -> Path:
+    """Write ``obj`` as JSON (``indent`` spaces, trailing newline, no NaN), atomically; returns the path."""
+    data = (json.dumps(obj, indent=indent, allow_nan=False) + "\n").encode()
     return atomic_write_bytes(path, data)

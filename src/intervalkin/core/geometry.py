@@ -27,6 +27,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from flint import arb, ctx, fmpq
+
 from intervalkin.core.errors import GeometryError
 from intervalkin.core.exact import arb_to_bounds, fraction_bounds
 
@@ -42,8 +44,6 @@ class Surd:
 
     def arb(self):
         """An arb ball containing the number, at the current flint precision."""
-        from flint import arb, fmpq
-
         c = arb(fmpq(self.coef.numerator, self.coef.denominator))
         if self.radicand == 1:
             return c
@@ -51,16 +51,9 @@ class Surd:
         return c * r.sqrt()
 
     def enclosure(self) -> tuple[float, float]:
-        """Floats (lo, hi) with lo <= value <= hi (outward rounded via arb)."""
-
-        from flint import ctx
-
-        old = ctx.prec
-        ctx.prec = 128
-        try:
+        """Floats (lo, hi) with lo <= value <= hi (outward rounded via arb at 128 bits)."""
+        with ctx.workprec(128):
             return arb_to_bounds(self.arb())
-        finally:
-            ctx.prec = old
 
     def square(self) -> Fraction:
         return self.coef * self.coef * self.radicand
@@ -114,30 +107,11 @@ class Geometry:
         outward; the phi bounds are the floats nearest to -pi and pi, and the
         phi axis is periodic, so nothing is lost at the seam.
         """
-        import numpy as np
-
         a1x, a1y = self.base[0]
         r = self.rho_max[0]
-        lo_x = float(a1x - r)
-        hi_x = float(a1x + r)
-        lo_y = float(a1y - r)
-        hi_y = float(a1y + r)
-        if Fraction(lo_x) > a1x - r:
-            lo_x = float(np.nextafter(lo_x, -np.inf))
-        if Fraction(hi_x) < a1x + r:
-            hi_x = float(np.nextafter(hi_x, np.inf))
-        if Fraction(lo_y) > a1y - r:
-            lo_y = float(np.nextafter(lo_y, -np.inf))
-        if Fraction(hi_y) < a1y + r:
-            hi_y = float(np.nextafter(hi_y, np.inf))
+        lo_x, hi_x = fraction_bounds(a1x - r)[0], fraction_bounds(a1x + r)[1]
+        lo_y, hi_y = fraction_bounds(a1y - r)[0], fraction_bounds(a1y + r)[1]
         return ((lo_x, hi_x), (lo_y, hi_y), (-math.pi, math.pi))
-
-    def joint_domain(self) -> tuple[tuple[float, float], ...]:
-        """The joint box prod_i [rho_min_i, rho_max_i], rounded outward to floats."""
-
-        return tuple(
-            (fraction_bounds(lo)[0], fraction_bounds(hi)[1]) for lo, hi in zip(self.rho_min, self.rho_max)
-        )
 
     def to_toml(self) -> str:
         """The geometry as TOML with the exact decimals that were read."""
@@ -202,6 +176,12 @@ def _table(doc: dict, key: str, allowed: set[str]) -> dict:
     return table
 
 
+def _require(table: dict, keys, prefix: str) -> None:
+    for k in keys:
+        if k not in table:
+            raise GeometryError(f"{prefix}.{k}: missing key")
+
+
 def _limits(value: Any, field: str, decimals: dict[str, str]) -> tuple[Fraction, Fraction, Fraction]:
     if isinstance(value, list):
         if len(value) != 3:
@@ -226,9 +206,7 @@ def parse_geometry(doc: dict, source: str = "geometry") -> Geometry:
         raise GeometryError(f"name: expected a non-empty string, got {name!r}")
 
     base_t = _table(doc, "base", _BASE_KEYS)
-    for k in sorted(_BASE_KEYS):
-        if k not in base_t:
-            raise GeometryError(f"base.{k}: missing key")
+    _require(base_t, sorted(_BASE_KEYS), "base")
     base = tuple(_point(base_t[f"a{i}"], f"base.a{i}", decimals) for i in (1, 2, 3))
     for i in range(3):
         for j in range(i + 1, 3):
@@ -241,9 +219,7 @@ def parse_geometry(doc: dict, source: str = "geometry") -> Geometry:
     if has_sides and has_coords:
         raise GeometryError("platform: give either side lengths (b1b2, b2b3, b3b1, b3_side) or coordinates (b1, b2, b3), not both")
     if has_sides:
-        for k in ("b1b2", "b2b3", "b3b1", "b3_side"):
-            if k not in plat_t:
-                raise GeometryError(f"platform.{k}: missing key")
+        _require(plat_t, ("b1b2", "b2b3", "b3b1", "b3_side"), "platform")
         l12 = _number(plat_t["b1b2"], "platform.b1b2", decimals)
         l23 = _number(plat_t["b2b3"], "platform.b2b3", decimals)
         l31 = _number(plat_t["b3b1"], "platform.b3b1", decimals)
@@ -265,9 +241,7 @@ def parse_geometry(doc: dict, source: str = "geometry") -> Geometry:
         s3x = Surd(p3x)
         s3y = Surd(Fraction(sign), l31 * l31 - p3x * p3x)
     elif has_coords:
-        for k in ("b1", "b2", "b3"):
-            if k not in plat_t:
-                raise GeometryError(f"platform.{k}: missing key")
+        _require(plat_t, ("b1", "b2", "b3"), "platform")
         b1, b2, b3 = (_point(plat_t[f"b{i}"], f"platform.b{i}", decimals) for i in (1, 2, 3))
         ex, ey = b2[0] - b1[0], b2[1] - b1[1]
         fx, fy = b3[0] - b1[0], b3[1] - b1[1]
@@ -283,9 +257,7 @@ def parse_geometry(doc: dict, source: str = "geometry") -> Geometry:
         raise GeometryError("platform: expected side lengths (b1b2, b2b3, b3b1, b3_side) or coordinates (b1, b2, b3)")
 
     lim_t = _table(doc, "limits", _LIMIT_KEYS)
-    for k in ("rho_min", "rho_max"):
-        if k not in lim_t:
-            raise GeometryError(f"limits.{k}: missing key")
+    _require(lim_t, ("rho_min", "rho_max"), "limits")
     rmin = _limits(lim_t["rho_min"], "limits.rho_min", decimals)
     rmax = _limits(lim_t["rho_max"], "limits.rho_max", decimals)
     for i in range(3):

@@ -1,21 +1,32 @@
-"""Vectorized interval arithmetic over numpy, rounded outward, and the bridge to arb.
+"""Vectorized interval arithmetic over numpy, rounded outward: the array half of the rounding layer.
 
-An :class:`Interval` holds two float64 arrays ``lo`` and ``hi`` of one shape: the
-k-th entry encloses the real interval [lo[k], hi[k]].  Every operation returns an
-enclosure of the exact range of the operation over its operands (the inclusion
-property), with rounding errors accounted for:
+An :class:`Interval` holds two float64 arrays ``lo`` and ``hi`` of one
+(broadcastable) shape: entry k stands for the real interval [lo[k], hi[k]].  Every
+operation returns an enclosure of the exact range of the operation over its
+operands (the inclusion property), rounding errors included:
 
 * ``+ - * /`` and ``sqrt`` are correctly rounded in IEEE 754 (round to nearest),
   so the exact result lies within half an ulp of the float result; moving the
-  float result one ulp outward (``np.nextafter`` toward -inf / +inf) encloses it.
-  This module is the only place that rounds (proofs/lemma-outward-rounding.md).
+  float result one ulp outward (:func:`round_down`, :func:`round_up`:
+  ``np.nextafter`` toward -inf / +inf) encloses it.
 * ``cos`` and ``sin`` of numpy are not correctly rounded.  We rely on the bound
   ``|fl(cos t) - cos t| <= TRIG_ABS_ERROR`` (and the same for sin) for
-  ``|t| <= TRIG_MAX_ARG``, a bound over 60 times the worst case observed (5.6e-17, a quarter of an ulp of 1)
-  and checked against arb on many thousands of arguments by
+  ``|t| <= TRIG_MAX_ARG``, a bound over 60 times the worst case observed (5.6e-17,
+  a quarter of an ulp of 1) and checked against arb on many thousands of arguments by
   ``tests/test_interval.py::test_trig_error_bound`` (proofs/lemma-trig-enclosure.md).
   Whether an interval holds an extremum of cos or sin is decided with an
   enclosure [PI_LO, PI_HI] of pi, conservatively (a possible extremum is included).
+  Outside [-TRIG_MAX_ARG, TRIG_MAX_ARG], or over a width of 2 pi or more, the
+  answer is [-1, 1].
+* Exact numbers (Fractions, arb balls) enter through
+  :func:`intervalkin.core.exact.fraction_bounds` and
+  :func:`~intervalkin.core.exact.arb_to_bounds` (the scalar half of the rounding
+  layer, free of numpy), or :meth:`Interval.from_exact` for arrays of them.
+
+These two modules are the only places in the package that move a float by an ulp
+(proofs/lemma-outward-rounding.md); ``tests/test_rounding.py`` switches
+:func:`round_down` and :func:`round_up` off and checks that the suite's soundness
+checks then fail.
 
 Interval comparisons never return a bare bool meaning "true": use
 :func:`certainly_positive` and friends, where False means "not proved".
@@ -24,9 +35,12 @@ Interval comparisons never return a bare bool meaning "true": use
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Union
+from fractions import Fraction
+from typing import Iterable, Union
 
 import numpy as np
+
+from intervalkin.core.exact import fraction_bounds
 
 __all__ = ['PI_LO', 'PI_HI', 'TRIG_ABS_ERROR', 'TRIG_MAX_ARG', 'round_down', 'round_up', 'Interval', 'certainly_positive', 'certainly_negative', 'sign_label']
 
@@ -54,13 +68,16 @@ def round_up(x: np.ndarray) -> np.ndarray:
 Operand = Union["Interval", float, int, np.ndarray]
 
 
-def _as_interval(v: Operand) -> "Interval":
+_POINT_TYPES = (float, int, np.ndarray, np.floating, np.integer)
+
+
+def _as_interval(v: Operand) -> "Interval | None":
+    """v as an Interval (a float is the exact number it represents: a point), None for other types."""
     if isinstance(v, Interval):
         return v
-    if not isinstance(v, (float, int, np.ndarray, np.floating, np.integer)):
-        raise TypeError(f"cannot combine an Interval with {type(v).__name__}")
+    if not isinstance(v, _POINT_TYPES):
+        return None
     a = np.asarray(v, dtype=np.float64)
-    # A float operand is taken as the exact number it represents (a point).
     return Interval(a, a)
 
 
@@ -70,6 +87,13 @@ class Interval:
 
     lo: np.ndarray
     hi: np.ndarray
+
+    #: numpy defers to the reflected operators (``2.0 * iv``, ``array - iv``) instead of
+    #: building object arrays of Intervals.
+    __array_ufunc__ = None
+    #: Not iterable: ``for v in iv`` would walk the first axis, never what a caller of a
+    #: per-leg function meant; index explicitly (``iv[:, i]``).
+    __iter__ = None
 
     # --- construction -----------------------------------------------------------------
     @staticmethod
@@ -81,6 +105,17 @@ class Interval:
     @staticmethod
     def from_bounds(lo, hi) -> "Interval":
         return Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64))
+
+    @staticmethod
+    def from_exact(values: Iterable[Fraction]) -> "Interval":
+        """Enclosures of exact rationals, one ulp wide at most (1-D, one entry per value).
+
+        >>> from fractions import Fraction
+        >>> Interval.from_exact([Fraction(1, 2)]).lo.tolist()
+        [0.5]
+        """
+        b = [fraction_bounds(Fraction(v)) for v in values]
+        return Interval(np.array([lo for lo, _ in b]), np.array([hi for _, hi in b]))
 
     # --- views ------------------------------------------------------------------------
     @property
@@ -123,19 +158,26 @@ class Interval:
 
     def __add__(self, other: Operand) -> "Interval":
         o = _as_interval(other)
+        if o is None:
+            return NotImplemented
         return Interval(round_down(self.lo + o.lo), round_up(self.hi + o.hi))
 
     __radd__ = __add__
 
     def __sub__(self, other: Operand) -> "Interval":
         o = _as_interval(other)
+        if o is None:
+            return NotImplemented
         return Interval(round_down(self.lo - o.hi), round_up(self.hi - o.lo))
 
     def __rsub__(self, other: Operand) -> "Interval":
-        return _as_interval(other) - self
+        o = _as_interval(other)
+        return NotImplemented if o is None else o - self
 
     def __mul__(self, other: Operand) -> "Interval":
         o = _as_interval(other)
+        if o is None:
+            return NotImplemented
         p1 = self.lo * o.lo
         p2 = self.lo * o.hi
         p3 = self.hi * o.lo
@@ -148,6 +190,8 @@ class Interval:
 
     def __truediv__(self, other: Operand) -> "Interval":
         o = _as_interval(other)
+        if o is None:
+            return NotImplemented
         zero_in = (o.lo <= 0) & (o.hi >= 0)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # inf bounds are still sound
             q1 = self.lo / o.lo
@@ -161,7 +205,8 @@ class Interval:
         return Interval(lo, hi)
 
     def __rtruediv__(self, other: Operand) -> "Interval":
-        return _as_interval(other) / self
+        o = _as_interval(other)
+        return NotImplemented if o is None else o / self
 
     def sqr(self) -> "Interval":
         """x^2 over the interval (tighter than x * x: one occurrence of x)."""

@@ -1,1 +1,9 @@
-"""TODO"""
+"""Kinematics of the 3-RPR: every formula written once, in each number system the package uses.
+
+constants    the geometry's constants as floats, outward intervals and arb balls (one cache)
+formulas     g (rho_i^2), the Jacobian A and det A: the formulas, and their float and arb versions
+enclosures   certified interval enclosures of rho_i^2, A (= grad rho_i^2), det A and grad det A over boxes
+sextic       the reduction of the direct kinematics to one polynomial in t = tan(phi / 2)
+
+Layer: imports only :mod:`intervalkin.core`; everything above evaluates kinematics through here.
+"""

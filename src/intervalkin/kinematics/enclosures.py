@@ -1,45 +1,44 @@
-"""Certified continuation of direct-kinematic solutions along joint-space paths.
+"""Certified enclosures of rho_i^2, det A and the Jacobian A over arrays of boxes, with gradients.
 
-Used by :mod:`intervalkin.space.basic_region` to tell which sheet above a joint cell a piece
-of certified boxes lies in (proofs/lemma-sheet-continuation.md).
+Every function takes boxes of shape (n, 3, 2) ((x, y, phi) x (lo, hi); phi in
+radians, any real) and returns :class:`~intervalkin.core.interval.Interval` arrays.
+Certified: for every box k and every point of box k, the exact value lies in entry k
+(outward-rounded interval arithmetic throughout; cos and sin with the error bound of
+:mod:`intervalkin.core.interval`).  The formulas are those of
+:mod:`intervalkin.kinematics.formulas`, evaluated here on intervals.
 
-Parameter Krawczyk test
------------------------
-Along a segment q(t) = q_a + t (q_b - q_a) of joint space (q_a, q_b exact, t a
-float) the system is F(X, t)_i = |B_i(X) - A_i|^2 - rho_i(t)^2.  For a box X,
-a parameter interval T = [t0, t1], a point m of X, a float matrix Y (inverse of
-the float Jacobian at m) and an interval matrix J(X) enclosing dF/dX over X
-(independent of t),
+The phi-tight form
+------------------
+For fixed phi, rho_i^2, w_i (the phi entry of row i of A, over 2) and Q = det A / 8
+are polynomials of degree at most 2 in (x, y); all the dependence on phi sits in the
+platform vectors r_i(phi) and, for Q, in the coefficients a..e(phi).  A quantity f of
+this kind is enclosed over a box b = [x] x [y] x [phi] by the intersection of three
+sound enclosures:
 
-    K(X, T) = m - Y F(m, tm) - (T - tm) Y dF/dt(m, T) + (I - Y J(X)) (X - m)
+1. centred form in phi:   f([x], [y], phi_m) + f_phi(b) ([phi] - phi_m)
+   (mean value theorem in phi; phi_m is a float in [phi], f_phi(b) an enclosure of
+   df/dphi over the whole box);
+2. natural form in phi:   f([x], [y], [phi]), the phi-dependent parts enclosed over
+   [phi] (for Q's coefficients, the hull of their enclosures over 8 pieces of [phi]:
+   a product of two functions of phi is enclosed much better piece by piece);
+3. monotonicity: where f_phi(b) has a certified sign, f over b lies between its
+   enclosures on the faces phi = phi_lo and phi = phi_hi.
 
-encloses m - Y F(m, t) + (I - Y J(X)) (X - m) for every t in T (mean value in t,
-dF_i/dt = -2 rho_i(t) (q_b - q_a)_i).  If K(X, T) lies in the interior of X,
-then for EVERY t in T the box X holds exactly one solution x(t), every Jacobian
-on X is non-singular (so det A keeps one sign on X) and t -> x(t) is continuous
-(proofs/lemma-krawczyk-uniqueness.md applied at each t; closed graph in a
-compact box).  Every zero of F(., t1) in X also lies in
+At fixed phi (or with the phi parts as intervals) the (x, y) part is enclosed
+without overestimation from the dependency problem: rho_i^2 = (d_ix + r_ix)^2 +
+(d_iy + r_iy)^2 is a sum of squares of independent terms; w_i = r_ix d_iy - r_iy d_ix is
+linear in (x, y); Q is written as its exact second-order Taylor expansion at the centre
+m of the (x, y) rectangle, Q(m) + grad Q(m) . (u, v) + a u^2 + b u v + c v^2.
 
-    K1 = p - Y F(p, t1) + (I - Y J(X)) (X - p)     (any point p of X),
+The derivatives in phi come from the formulas: d r_i / d phi = (-r_iy, r_ix), so
+d rho_i^2 / d phi = 2 w_i and d w_i / d phi = -(r_i . d_i); the coefficients of Q are
+differentiated in forward mode with :class:`PhiDual` (the package's one derivative
+type).  The phi-dependent parts are computed once per distinct phi range of the array
+(a paving level has at most 2**level of them), so most of the cost is per-box (x, y)
+arithmetic.
 
-so K1 n X is a box that holds the solution at t1 (no interior test needed).
-All of it is evaluated with :class:`intervalkin.core.interval.Interval` (outward
-rounding), vectorized over many tracks at once.
-
-Tracking
---------
-A track carries a box Z known to hold the followed solution at q(t).  A step
-[t, t1] predicts the solution at t1 in float (tangent + Newton), builds X around
-both ends and around Z, and accepts the step when K(X, [t, t1]) is inside X:
-the followed solution is then the unique one in X for all of [t, t1], and
-Z := K1 n X at t1.  The step doubles on success and halves on failure, with a
-floor below which the track gives up (never a guess).
-
-Voxel paths
------------
-Paths run inside one joint cell: between centres of face-adjacent voxels of the
-cell (the segment lies in the union of the two closed voxels), in straight runs
-along a breadth-first tree of the cell rooted at the cell's witness voxel.
+Gradients: the Jacobian A is the gradient of (rho_1^2, rho_2^2, rho_3^2)
+(:func:`jacobian_interval`); :func:`det_a_gradient_interval` encloses grad det A.
 """
 
 from __future__ import annotations
@@ -48,179 +47,299 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
-from intervalkin.kinematics.constants import KinematicConstants, _k, constants
-from intervalkin.kinematics.formulas import _det_formula, _rho_sq_formula
+from intervalkin.kinematics.constants import KinematicConstants, constants
+from intervalkin.kinematics.formulas import det_coefficients, leg_moment, leg_rho_sq, quadratic, quadratic_gradient
 
-__all__ = ['rho_sq_interval', 'rho_interval', 'det_a_interval']
+__all__ = ['PhiDual', 'rho_sq_interval', 'rho_interval', 'jacobian_interval', 'det_a_interval',
+           'det_a_gradient_interval']
+
+#: Pieces of each phi range over which the coefficients of det A are enclosed (their hull is used).
+DET_PHI_PIECES = 8
 
 
-# --------------------------------------------------------------------------------------
-# Forward-mode derivatives over intervals, for the centred form
-# --------------------------------------------------------------------------------------
-@dataclass(frozen=True, eq=False)
-class _Jet:
-    """An interval value with an interval enclosure of its gradient in (x, y, phi)."""
+class PhiDual:
+    """An Interval value v with an Interval enclosure d of its derivative in phi (forward mode).
 
-    val: Interval
-    grad: tuple[Interval, Interval, Interval]
+    Sound operations: (u, u') + (v, v') = (u + v, u' + v') and
+    (u, u') (v, v') = (u v, u' v + u v'); other operands are constants in phi.
+    """
+
+    __slots__ = ("v", "d")
+
+    def __init__(self, v: Interval, d: Interval):
+        self.v, self.d = v, d
 
     def __add__(self, o):
-        if isinstance(o, _Jet):
-            return _Jet(self.val + o.val, tuple(a + b for a, b in zip(self.grad, o.grad)))
-        return _Jet(self.val + o, self.grad)
+        return PhiDual(self.v + o.v, self.d + o.d) if isinstance(o, PhiDual) else PhiDual(self.v + o, self.d)
 
     __radd__ = __add__
 
-    def __neg__(self):
-        return _Jet(-self.val, tuple(-g for g in self.grad))
-
     def __sub__(self, o):
-        return self + (-o)
+        return PhiDual(self.v - o.v, self.d - o.d) if isinstance(o, PhiDual) else PhiDual(self.v - o, self.d)
 
     def __rsub__(self, o):
-        return (-self) + o
+        return PhiDual(o - self.v, -self.d)
+
+    def __neg__(self):
+        return PhiDual(-self.v, -self.d)
 
     def __mul__(self, o):
-        if isinstance(o, _Jet):
-            return _Jet(self.val * o.val, tuple(a * o.val + self.val * b for a, b in zip(self.grad, o.grad)))
-        return _Jet(self.val * o, tuple(g * o for g in self.grad))
+        if isinstance(o, PhiDual):
+            return PhiDual(self.v * o.v, self.d * o.v + self.v * o.d)
+        return PhiDual(self.v * o, self.d * o)
 
     __rmul__ = __mul__
 
-    def sqr(self):
-        two_v = self.val * 2.0
-        return _Jet(self.val.sqr(), tuple(two_v * g for g in self.grad))
-
-
-class _IntervalOps:
-    """Number system: sound intervals (natural extension)."""
-
-    @staticmethod
-    def sq(v):
-        return v.sqr()
-
-    @staticmethod
-    def rot(phi, k: KinematicConstants, i: int):
-        """r_i = L_i (cos(phi + alpha_i), sin(phi + alpha_i)) as (value) intervals."""
-        t = phi + k.alpha_iv[i]
-        L = k.radius_iv[i]
-        return L * t.cos(), L * t.sin()
-
-    @staticmethod
-    def base(k: KinematicConstants, i: int):
-        return k.ax_iv[i], k.ay_iv[i]
-
-
-class _JetOps(_IntervalOps):
-    """Number system: intervals with gradients (phi is a _Jet with grad (0, 0, 1))."""
-
-    @staticmethod
-    def rot(phi: _Jet, k: KinematicConstants, i: int):
-        t = phi.val + k.alpha_iv[i]
-        L = k.radius_iv[i]
-        c, s = L * t.cos(), L * t.sin()
-        zero = Interval.point(0.0)
-        return _Jet(c, (zero, zero, -s)), _Jet(s, (zero, zero, c))
-
 
 # --------------------------------------------------------------------------------------
-# Interval versions over arrays of boxes
+# The phi ranges of an array of boxes
 # --------------------------------------------------------------------------------------
-def _box_intervals(boxes: np.ndarray):
-    b = np.asarray(boxes, dtype=np.float64)
-    return tuple(Interval(b[:, j, 0], b[:, j, 1]) for j in range(3))
+@dataclass(frozen=True, eq=False)
+class _PhiRanges:
+    """The distinct phi ranges of the boxes, sampled once each.
 
-
-def _centred(geometry: Geometry, boxes: np.ndarray, formula) -> list[Interval] | Interval:
-    """Natural extension intersected with the mean-value form, for each output of formula."""
-    k = constants(geometry)
-    x, y, phi = _box_intervals(boxes)
-    zero, one = Interval.point(0.0), Interval.point(1.0)
-    jx = _Jet(x, (one, zero, zero))
-    jy = _Jet(y, (zero, one, zero))
-    jp = _Jet(phi, (zero, zero, one))
-    jets = formula(_JetOps, k, jx, jy, jp)
-    mx, my, mp = x.mid(), y.mid(), phi.mid()
-    at_mid = formula(_IntervalOps, k, Interval.point(mx), Interval.point(my), Interval.point(mp))
-    single = not isinstance(jets, list)
-    if single:
-        jets, at_mid = [jets], [at_mid]
-    out = []
-    for jet, fm in zip(jets, at_mid):
-        mv = fm + jet.grad[0] * (x - mx) + jet.grad[1] * (y - my) + jet.grad[2] * (phi - mp)
-        out.append(jet.val.intersect(mv))
-    return out[0] if single else out
-
-
-def rho_sq_interval(geometry: Geometry, boxes: np.ndarray) -> list[Interval]:
-    """Enclosures of rho_i^2 over each box; boxes of shape (n, 3, 2) -> three (n,) Intervals.
-
-    Certified: every value of rho_i^2 at a point of box k lies in the k-th interval.
+    ``samples`` is an Interval (u, c): its first ``pieces`` columns cover [phi_lo, phi_hi]
+    (consecutive pieces share their ends), ``cols`` gives the thin columns phi_lo, phi_m,
+    phi_hi (None: not sampled).  When every range is a single float (``thin``) there is one
+    column and the natural form is the whole answer.  ``inv`` (n,) maps each box to its
+    range (None: one range per box, in order); ``offset`` (n,) is [phi] - phi_m.
     """
-    return _centred(geometry, boxes, _rho_sq_formula)
+
+    samples: Interval
+    pieces: int
+    cols: tuple
+    thin: bool
+    inv: np.ndarray | None
+    offset: Interval
 
 
-def rho_interval(geometry: Geometry, boxes: np.ndarray) -> list[Interval]:
-    """Enclosures of rho_i = |B_i - A_i| over each box (sqrt of :func:`rho_sq_interval`)."""
-    return [r.sqrt() for r in rho_sq_interval(geometry, boxes)]
+def _phi_ranges(boxes: np.ndarray, pieces: int, ends: bool = True) -> _PhiRanges:
+    if np.array_equal(boxes[:, 2, 0], boxes[:, 2, 1]):  # points in phi: one sample per box
+        phi = boxes[:, 2, :1]
+        offset = Interval.point(np.zeros(len(boxes)))
+        return _PhiRanges(Interval(phi, phi), 1, (0, 0, 0), True, None, offset)
+    key = boxes[:, 2, 0] + 1j * boxes[:, 2, 1]
+    u, inv = np.unique(key, return_inverse=True)
+    inv = inv.reshape(-1)
+    pl, ph = u.real.copy(), u.imag.copy()
+    pm = np.minimum(np.maximum(0.5 * pl + 0.5 * ph, pl), ph)
+    s = np.arange(pieces + 1, dtype=np.float64) / pieces
+    cuts = pl[:, None] + (ph - pl)[:, None] * s[None, :]
+    cuts[:, 0], cuts[:, -1] = pl, ph
+    cuts = np.maximum.accumulate(np.minimum(np.maximum(cuts, pl[:, None]), ph[:, None]), axis=1)
+    thin = [pl, pm, ph] if ends else [pm]
+    lo = np.concatenate([cuts[:, :-1]] + [t[:, None] for t in thin], axis=1)
+    hi = np.concatenate([cuts[:, 1:]] + [t[:, None] for t in thin], axis=1)
+    cols = (pieces, pieces + 1, pieces + 2) if ends else (None, pieces, None)
+    offset = Interval(boxes[:, 2, 0], boxes[:, 2, 1]) - pm[inv]
+    return _PhiRanges(Interval(lo, hi), pieces, cols, False, inv, offset)
 
 
-def det_a_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:
-    """Enclosure of det A over each box; boxes (n, 3, 2) -> (n,) Interval. Certified."""
-    d = _centred(geometry, boxes, _det_formula)
-    return d * 8.0
+@dataclass(frozen=True, eq=False)
+class _OverPhi:
+    """A function of phi on each distinct phi range (arrays (u,)): ``value`` its range,
+    ``slope`` the range of its derivative, ``at_lo``, ``at_mid``, ``at_hi`` its values at
+    phi_lo, phi_m, phi_hi.  :meth:`box` gathers one of them to the boxes, (n,), when it is
+    used (gathering all of them at once would hold many (n,) arrays at the same time)."""
+
+    fields: dict
+    rows: object
+
+    def box(self, name: str) -> Interval:
+        v = self.fields[name]
+        return Interval(v.lo[self.rows], v.hi[self.rows])
 
 
-def _stack(parts, axis):
+def _over_phi(ph: _PhiRanges, duals) -> list[_OverPhi]:
+    """The PhiDuals evaluated on ``ph.samples``, as functions over each phi range."""
+    p = ph.pieces
+    rows = slice(None) if ph.inv is None else ph.inv
+
+    def hull(lo, hi):
+        return Interval(lo[:, 0], hi[:, 0]) if p == 1 else Interval(np.min(lo[:, :p], axis=1), np.max(hi[:, :p], axis=1))
+
+    out = []
+    for f in duals:
+        v_lo, v_hi = np.broadcast_arrays(f.v.lo, f.v.hi)
+        d_lo, d_hi = np.broadcast_arrays(f.d.lo, f.d.hi)
+        fields = {"value": hull(v_lo, v_hi), "slope": hull(d_lo, d_hi)}
+        for name, c in zip(("at_lo", "at_mid", "at_hi"), ph.cols):
+            if c is not None:
+                fields[name] = Interval(v_lo[:, c], v_hi[:, c])
+        out.append(_OverPhi(fields, rows))
+    return out
+
+
+def _rotation(k: KinematicConstants, i: int, phi: Interval) -> tuple[PhiDual, PhiDual]:
+    """r_i = L_i (cos(phi + alpha_i), sin(phi + alpha_i)) with its derivative (-r_iy, r_ix)."""
+    t = phi + k.alpha_iv[i]
+    L = k.radius_iv[i]
+    c, s = L * t.cos(), L * t.sin()
+    return PhiDual(c, -s), PhiDual(s, c)
+
+
+def _phi_tight(form, slope: Interval, offset: Interval, ends: bool = True) -> Interval:
+    """Centred form in phi, intersected with the natural form and, where the slope has a sign
+    and ``ends``, monotonicity.
+
+    ``form(name)`` evaluates the quantity over the boxes with its phi-dependent parts taken
+    as ``name`` ("at_mid", "value", "at_lo", "at_hi"; see :class:`_OverPhi`); the forms are
+    evaluated one after the other, so few (n,) temporaries live at once.
+    """
+    e = (form("at_mid") + slope * offset).intersect(form("value"))
+    if not ends:
+        return e
+    up, down = slope.lo > 0, slope.hi < 0
+    face = form("at_lo")  # the minimum where increasing, the maximum where decreasing
+    lo, hi = np.where(up, face.lo, e.lo), np.where(down, face.hi, e.hi)
+    face = form("at_hi")
+    lo, hi = np.where(down, face.lo, lo), np.where(up, face.hi, hi)
+    return e.intersect(Interval(lo, hi))
+
+
+def _stack(parts: list[Interval], axis: int) -> Interval:
     return Interval(np.stack([np.broadcast_to(p.lo, p.shape) for p in parts], axis=axis),
                     np.stack([np.broadcast_to(p.hi, p.shape) for p in parts], axis=axis))
 
 
-def _legs_interval(geometry: Geometry, x: Interval, y: Interval, phi: Interval):
-    """Per leg i: (x - a_ix, y - a_iy, r_ix, r_iy) as Intervals (r_1 = 0)."""
-    k = _k(geometry)
-    out = []
+def _boxes(boxes) -> np.ndarray:
+    b = np.asarray(boxes, dtype=np.float64)
+    if b.ndim != 3 or b.shape[1:] != (3, 2):
+        raise InputError(f"boxes: expected an array of shape (n, 3, 2), got shape {b.shape}")
+    return b
+
+
+def _leg_offsets(k: KinematicConstants, b: np.ndarray, i: int) -> tuple[Interval, Interval]:
+    """d_i = B1 - A_i over the boxes."""
+    return Interval(b[:, 0, 0], b[:, 0, 1]) - k.ax_iv[i], Interval(b[:, 1, 0], b[:, 1, 1]) - k.ay_iv[i]
+
+
+# --------------------------------------------------------------------------------------
+# rho_i^2 and the Jacobian (its gradient)
+# --------------------------------------------------------------------------------------
+def rho_sq_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:
+    """Enclosures of rho_i^2 = |B_i - A_i|^2 over each box: boxes (n, 3, 2) -> Interval (n, 3).
+
+    Leg 1 is (x - a_1x)^2 + (y - a_1y)^2 (exact ranges of two squares); legs 2 and 3
+    take the phi-tight form (module docstring) with slope 2 w_i.  Certified.
+    """
+    b = _boxes(boxes)
+    k = constants(geometry)
+    ph = _phi_ranges(b, 1)
+    out = Interval(np.empty((len(b), 3)), np.empty((len(b), 3)))  # filled leg by leg (peak memory)
     for i in range(3):
-        dx, dy = x - k.ax_iv[i], y - k.ay_iv[i]
+        dx, dy = _leg_offsets(k, b, i)
         if i == 0:
-            out.append((dx, dy, None, None))
+            e = leg_rho_sq(dx, dy)
         else:
-            ang = phi + k.alpha_iv[i]
-            out.append((dx, dy, k.radius_iv[i] * ang.cos(), k.radius_iv[i] * ang.sin()))
+            rx, ry = _over_phi(ph, _rotation(k, i, ph.samples))
+
+            def form(name):
+                return leg_rho_sq(dx, dy, rx.box(name), ry.box(name))
+
+            if ph.thin:
+                e = form("value")
+            else:
+                slope = leg_moment(dx, dy, rx.box("value"), ry.box("value")) * 2.0
+                e = _phi_tight(form, slope, ph.offset)
+        out.lo[:, i], out.hi[:, i] = e.lo, e.hi
     return out
 
 
-def rho_sq_enclosure(geometry: Geometry, lo: np.ndarray, hi: np.ndarray) -> Interval:
-    """rho_i^2 = |B_i - A_i|^2 over boxes [lo, hi] (m, 3): Interval (m, 3) (natural form)."""
-    x, y, phi = (Interval(lo[:, j], hi[:, j]) for j in range(3))
-    parts = []
-    for dx, dy, rx, ry in _legs_interval(geometry, x, y, phi):
-        ux, uy = (dx, dy) if rx is None else (dx + rx, dy + ry)
-        parts.append(ux.sqr() + uy.sqr())
-    return _stack(parts, 1)
+def rho_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:
+    """Enclosures of rho_i = |B_i - A_i| over each box (square root of :func:`rho_sq_interval`), (n, 3)."""
+    return rho_sq_interval(geometry, boxes).sqrt()
 
 
-def jacobian_enclosure(geometry: Geometry, lo: np.ndarray, hi: np.ndarray) -> Interval:
-    """A = dF/dX over boxes [lo, hi] (m, 3): Interval (m, 3, 3).
+def jacobian_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:
+    """A = dF/dX = grad (rho_1^2, rho_2^2, rho_3^2) over each box: boxes (n, 3, 2) -> Interval (n, 3, 3).
 
-    Row i is 2 (u_ix, u_iy, w_i) with u_i = B1 - A_i + r_i and w_i = r_i x (B1 - A_i).
-    The first two columns hold x, y, phi once each (natural form); w_i is the
-    natural form intersected with its mean-value form about the box centre
-    (dw/dx = -r_iy, dw/dy = r_ix, dw/dphi = -(r_ix d_ix + r_iy d_iy), d_i = B1 - A_i).
+    Row i is 2 (d_ix + r_ix, d_iy + r_iy, w_i): the first two entries in natural form
+    (d_i and r_i are independent), w_i in the centred form in phi (slope -(r_i . d_i))
+    intersected with the natural form; the faces phi_lo, phi_hi are not sampled (the
+    Krawczyk boxes this serves are narrow in phi, where monotonicity adds nothing).
+    Certified.
     """
-    x, y, phi = (Interval(lo[:, j], hi[:, j]) for j in range(3))
-    m = Interval(lo, hi).mid()
-    mx, my, mp = (Interval.point(m[:, j]) for j in range(3))
-    at_mid = _legs_interval(geometry, mx, my, mp)
-    rows = []
-    for (dx, dy, rx, ry), (cx, cy, crx, cry) in zip(_legs_interval(geometry, x, y, phi), at_mid):
-        if rx is None:
-            rows.append(_stack([dx * 2.0, dy * 2.0, Interval.point(np.zeros(lo.shape[0]))], 1))
-            continue
-        natural = rx * dy - ry * dx
-        centred = (crx * cy - cry * cx) + (-ry) * (x - mx) + rx * (y - my) + (-(rx * dx + ry * dy)) * (phi - mp)
-        w = natural.intersect(centred)
-        rows.append(_stack([(dx + rx) * 2.0, (dy + ry) * 2.0, w * 2.0], 1))
+    b = _boxes(boxes)
+    k = constants(geometry)
+    ph = _phi_ranges(b, 1, ends=False)
+    dx, dy = _leg_offsets(k, b, 0)
+    rows = [_stack([dx * 2.0, dy * 2.0, Interval.point(np.zeros(len(b)))], 1)]
+    for i in (1, 2):
+        dx, dy = _leg_offsets(k, b, i)
+        rx, ry = _over_phi(ph, _rotation(k, i, ph.samples))
+        Rx, Ry = rx.box("value"), ry.box("value")
+        w = leg_moment(dx, dy, PhiDual(Rx, rx.box("slope")), PhiDual(Ry, ry.box("slope")))
+        if not ph.thin:
+            w = _phi_tight(lambda name: w.v if name == "value" else leg_moment(dx, dy, rx.box(name), ry.box(name)),
+                           w.d, ph.offset, ends=False)
+        else:
+            w = w.v
+        rows.append(_stack([(dx + Rx) * 2.0, (dy + Ry) * 2.0, w * 2.0], 1))
     return _stack(rows, 1)
+
+
+# --------------------------------------------------------------------------------------
+# det A and its gradient
+# --------------------------------------------------------------------------------------
+def _det_coefficients_over(k: KinematicConstants, ph: _PhiRanges) -> list[_OverPhi]:
+    e2x, e2y = k.ax_iv[1] - k.ax_iv[0], k.ay_iv[1] - k.ay_iv[0]
+    e3x, e3y = k.ax_iv[2] - k.ax_iv[0], k.ay_iv[2] - k.ay_iv[0]
+    r2x, r2y = _rotation(k, 1, ph.samples)
+    r3x, r3y = _rotation(k, 2, ph.samples)
+    return _over_phi(ph, det_coefficients(r2x, r2y, r3x, r3y, e2x, e2y, e3x, e3y))
+
+
+def _taylor(coef, Xm: Interval, Ym: Interval, U: Interval, V: Interval) -> Interval:
+    """The quadratic over X = Xm + U, Y = Ym + V, as its exact Taylor expansion at (Xm, Ym)."""
+    a, b, c = coef[:3]
+    gx, gy = quadratic_gradient(coef, Xm, Ym)
+    return quadratic(coef, Xm, Ym) + gx * U + gy * V + a * U.sqr() + b * (U * V) + c * V.sqr()
+
+
+def _centre_offsets(k: KinematicConstants, b: np.ndarray):
+    """X = x - a_1x = Xm + U and Y = y - a_1y = Ym + V: centres (thin) and offsets over each box."""
+    x, y = Interval(b[:, 0, 0], b[:, 0, 1]), Interval(b[:, 1, 0], b[:, 1, 1])
+    xm, ym = x.mid(), y.mid()
+    return Interval.point(xm) - k.ax_iv[0], Interval.point(ym) - k.ay_iv[0], x - xm, y - ym
+
+
+def _det_q(geometry: Geometry, b: np.ndarray):
+    """(Q enclosure, coefficients over phi, slope dQ/dphi over the box) with Q = det A / 8."""
+    k = constants(geometry)
+    ph = _phi_ranges(b, DET_PHI_PIECES)
+    co = _det_coefficients_over(k, ph)
+    Xm, Ym, U, V = _centre_offsets(k, b)
+
+    def form(name):
+        return _taylor([c.box(name) for c in co], Xm, Ym, U, V)
+
+    slope = form("slope")
+    q = form("value") if ph.thin else _phi_tight(form, slope, ph.offset)
+    return q, co, slope
+
+
+def det_a_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:
+    """Enclosure of det A over each box: boxes (n, 3, 2) -> Interval (n,).
+
+    The phi-tight form of Q = det A / 8 (module docstring), times 8.  Certified.
+    """
+    q, _, _ = _det_q(geometry, _boxes(boxes))
+    return q * 8.0
+
+
+def det_a_gradient_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:
+    """Enclosure of grad det A = (d/dx, d/dy, d/dphi) det A over each box: Interval (n, 3).
+
+    d/dx and d/dy are 8 (2 a X + b Y + d) and 8 (b X + 2 c Y + e) with the coefficients
+    over the phi range; d/dphi is 8 dQ/dphi, the slope of the centred form.  Certified.
+    """
+    b = _boxes(boxes)
+    k = constants(geometry)
+    _, co, slope = _det_q(geometry, b)
+    Xm, Ym, U, V = _centre_offsets(k, b)
+    gx, gy = quadratic_gradient([c.box("value") for c in co], Xm + U, Ym + V)
+    return _stack([gx, gy, slope], 1) * 8.0

@@ -1,231 +1,215 @@
-"""Certified continuation of direct-kinematic solutions along joint-space paths.
+"""The formulas of the 3-RPR (g, A, det A), written once, evaluated in float and in arb.
 
-Used by :mod:`intervalkin.space.basic_region` to tell which sheet above a joint cell a piece
-of certified boxes lies in (proofs/lemma-sheet-continuation.md).
+Notation (DESIGN.md sections 1 and 2).  A pose is X = (x, y, phi), B1 = (x, y).  Leg i
+has base point A_i and platform point p_i (p_1 = 0), turned by the orientation:
+r_i = R(phi) p_i, so B_i = B1 + r_i.  With d_i = B1 - A_i:
 
-Parameter Krawczyk test
------------------------
-Along a segment q(t) = q_a + t (q_b - q_a) of joint space (q_a, q_b exact, t a
-float) the system is F(X, t)_i = |B_i(X) - A_i|^2 - rho_i(t)^2.  For a box X,
-a parameter interval T = [t0, t1], a point m of X, a float matrix Y (inverse of
-the float Jacobian at m) and an interval matrix J(X) enclosing dF/dX over X
-(independent of t),
+    rho_i^2 = |d_i + r_i|^2                                       (inverse kinematics g)
+    F_i(X, q) = rho_i(X)^2 - q_i^2,  A = dF/dX,
+    row i of A = 2 (d_ix + r_ix, d_iy + r_iy, w_i),   w_i = r_i x d_i = r_ix d_iy - r_iy d_ix.
 
-    K(X, T) = m - Y F(m, tm) - (T - tm) Y dF/dt(m, T) + (I - Y J(X)) (X - m)
+Because dr_i/dphi = (-r_iy, r_ix), the derivative of rho_i^2 in phi is 2 w_i: row i of
+A is the gradient of rho_i^2, and d w_i / d phi = -(r_i . d_i) is w_i with r_i turned
+by a right angle.  For det A put X = x - a_1x, Y = y - a_1y, e_i = A_i - A_1 (i = 2, 3)
+and k_i = r_iy e_ix - r_ix e_iy.  Expanding det A along the structure of its rows,
 
-encloses m - Y F(m, t) + (I - Y J(X)) (X - m) for every t in T (mean value in t,
-dF_i/dt = -2 rho_i(t) (q_b - q_a)_i).  If K(X, T) lies in the interior of X,
-then for EVERY t in T the box X holds exactly one solution x(t), every Jacobian
-on X is non-singular (so det A keeps one sign on X) and t -> x(t) is continuous
-(proofs/lemma-krawczyk-uniqueness.md applied at each t; closed graph in a
-compact box).  Every zero of F(., t1) in X also lies in
+    det A = 8 Q,   Q = a X^2 + b X Y + c Y^2 + d X + e Y,
 
-    K1 = p - Y F(p, t1) + (I - Y J(X)) (X - p)     (any point p of X),
+a quadratic form in (X, Y) without constant term, whose coefficients are
+trigonometric polynomials in phi (:func:`det_coefficients`).  det A = 0 exactly when
+the three leg lines meet in one point or are parallel.
 
-so K1 n X is a box that holds the solution at t1 (no interior test needed).
-All of it is evaluated with :class:`intervalkin.core.interval.Interval` (outward
-rounding), vectorized over many tracks at once.
-
-Tracking
---------
-A track carries a box Z known to hold the followed solution at q(t).  A step
-[t, t1] predicts the solution at t1 in float (tangent + Newton), builds X around
-both ends and around Z, and accepts the step when K(X, [t, t1]) is inside X:
-the followed solution is then the unique one in X for all of [t, t1], and
-Z := K1 n X at t1.  The step doubles on success and halves on failure, with a
-floor below which the track gives up (never a guess).
-
-Voxel paths
------------
-Paths run inside one joint cell: between centres of face-adjacent voxels of the
-cell (the segment lies in the union of the two closed voxels), in straight runs
-along a breadth-first tree of the cell rooted at the cell's witness voxel.
+The functions :func:`leg_rho_sq`, :func:`leg_moment`, :func:`det_coefficients`,
+:func:`quadratic` and :func:`quadratic_gradient` use only ``+ - *`` and so work in every
+number system of the package: float arrays here (``approx_*``, not certified), arb
+balls here (``*_arb``, the trusted reference, sound at any precision), and intervals
+and phi-derivatives in :mod:`intervalkin.kinematics.enclosures` (certified
+enclosures over boxes).  Only the rotation r_i(phi) differs between the systems: in
+float L_i (cos, sin)(phi + alpha_i) with rounded constants; in arb the exact
+platform point turned by the ball's cos and sin.
 """
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.kinematics.constants import KinematicConstants, constants
+from intervalkin.core.interval import Interval
+from intervalkin.kinematics.constants import constants
 
-__all__ = ['approx_inverse_kinematics', 'approx_det_a', 'approx_jacobian', 'inverse_kinematics_arb', 'det_a_arb', 'residual_arb', 'jacobian_arb']
-
-
-class _FloatOps:
-    """Number system: float64 (approximate)."""
-
-    @staticmethod
-    def sq(v):
-        return v * v
-
-    @staticmethod
-    def rot(phi, k: KinematicConstants, i: int):
-        t = phi + k.alpha[i]
-        return k.radius[i] * np.cos(t), k.radius[i] * np.sin(t)
-
-    @staticmethod
-    def base(k: KinematicConstants, i: int):
-        return k.ax[i], k.ay[i]
-
-
-class _ArbOps:
-    """Number system: arb balls; constants from the exact geometry."""
-
-    def __init__(self, geometry: Geometry):
-        from flint import arb, fmpq
-
-        self.p = [tuple(c.arb() for c in geometry.platform_point(i)) for i in range(3)]
-        self.a = [tuple(arb(fmpq(c.numerator, c.denominator)) for c in pt) for pt in geometry.base]
-
-    @staticmethod
-    def sq(v):
-        return v * v
-
-    def rot(self, phi, k, i: int):
-        c, s = phi.cos(), phi.sin()
-        px, py = self.p[i]
-        return px * c - py * s, px * s + py * c
-
-    def base(self, k, i: int):
-        return self.a[i]
+__all__ = ['leg_rho_sq', 'leg_moment', 'det_coefficients', 'quadratic', 'quadratic_gradient',
+           'approx_rho_sq', 'approx_inverse_kinematics', 'approx_det_a', 'approx_jacobian',
+           'rho_sq_arb', 'inverse_kinematics_arb', 'det_a_arb', 'residual_arb', 'jacobian_arb']
 
 
 # --------------------------------------------------------------------------------------
-# The formulas, written once
+# The formulas, for any number system with + - *
 # --------------------------------------------------------------------------------------
-def _legs(ops, k, x, y, phi):
-    """Per leg: (u_i, r_i, a_i) with u_i = B_i - A_i."""
+def _square(v):
+    """v^2; over an Interval the range of the square (one occurrence of v), not v * v."""
+    return v.sqr() if isinstance(v, Interval) else v * v
+
+
+def leg_rho_sq(dx, dy, rx=None, ry=None):
+    """rho_i^2 = |d_i + r_i|^2 from d_i = B1 - A_i and r_i = R(phi) p_i (None: p_i = 0)."""
+    if rx is None:
+        return _square(dx) + _square(dy)
+    return _square(dx + rx) + _square(dy + ry)
+
+
+def leg_moment(dx, dy, rx, ry):
+    """w_i = r_i x d_i = r_ix d_iy - r_iy d_ix: half of d(rho_i^2)/d(phi), entry (i, phi) of A / 2."""
+    return rx * dy - ry * dx
+
+
+def det_coefficients(r2x, r2y, r3x, r3y, e2x, e2y, e3x, e3y) -> tuple:
+    """(a, b, c, d, e) of Q = det A / 8 = a X^2 + b X Y + c Y^2 + d X + e Y.
+
+    Arguments: r_2, r_3 (platform vectors at phi) and e_i = A_i - A_1.  With
+    D_i = r_i - e_i (= d_i + r_i - d_1, leg i's vector relative to leg 1) and
+    k_i = r_iy e_ix - r_ix e_iy, one has w_i = r_ix Y - r_iy X + k_i and
+    Q = X (D_2y w_3 - w_2 D_3y) - Y (D_2x w_3 - w_2 D_3x) (row reduction of A by row 1);
+    collecting powers of X and Y,
+
+        a = r_2y D_3y - r_3y D_2y,      b = (r_3x D_2y - r_2x D_3y) - (r_2y D_3x - r_3y D_2x),
+        c = r_2x D_3x - r_3x D_2x,      d = D_2y k_3 - k_2 D_3y,    e = k_2 D_3x - D_2x k_3.
+
+    ``tests/test_kinematics.py`` checks 8 Q against the determinant of A in arb.
+    """
+    k2 = r2y * e2x - r2x * e2y
+    k3 = r3y * e3x - r3x * e3y
+    d2x, d2y = r2x - e2x, r2y - e2y
+    d3x, d3y = r3x - e3x, r3y - e3y
+    a = r2y * d3y - r3y * d2y
+    b = (r3x * d2y - r2x * d3y) - (r2y * d3x - r3y * d2x)
+    c = -(r3x * d2x - r2x * d3x)
+    d = d2y * k3 - k2 * d3y
+    e = -(d2x * k3 - k2 * d3x)
+    return a, b, c, d, e
+
+
+def quadratic(coef, X, Y):
+    """a X^2 + b X Y + c Y^2 + d X + e Y, evaluated as X (a X + b Y + d) + Y (c Y + e)."""
+    a, b, c, d, e = coef
+    return X * (a * X + b * Y + d) + Y * (c * Y + e)
+
+
+def quadratic_gradient(coef, X, Y) -> tuple:
+    """(d/dX, d/dY) of :func:`quadratic`: (2 a X + b Y + d, b X + 2 c Y + e)."""
+    a, b, c, d, e = coef
+    return (a * X) * 2.0 + b * Y + d, b * X + (c * Y) * 2.0 + e
+
+
+def _legs(base, rotation, x, y, phi) -> list[tuple]:
+    """[(d_ix, d_iy, r_ix, r_iy)] for the three legs; r_1 = (None, None)."""
     out = []
     for i in range(3):
-        ax, ay = ops.base(k, i)
-        if i == 0:
-            out.append(((x - ax, y - ay), None, (ax, ay)))
-        else:
-            rx, ry = ops.rot(phi, k, i)
-            out.append(((x + rx - ax, y + ry - ay), (rx, ry), (ax, ay)))
+        ax, ay = base[i]
+        rx, ry = (None, None) if i == 0 else rotation(i, phi)
+        out.append((x - ax, y - ay, rx, ry))
     return out
 
 
-def _rho_sq_formula(ops, k, x, y, phi):
-    return [ops.sq(ux) + ops.sq(uy) for (ux, uy), _, _ in _legs(ops, k, x, y, phi)]
+def _det(base, legs, x, y):
+    """det A = 8 Q from the legs' rotations (any number system)."""
+    (_, _, r2x, r2y), (_, _, r3x, r3y) = legs[1], legs[2]
+    e2x, e2y = base[1][0] - base[0][0], base[1][1] - base[0][1]
+    e3x, e3y = base[2][0] - base[0][0], base[2][1] - base[0][1]
+    coef = det_coefficients(r2x, r2y, r3x, r3y, e2x, e2y, e3x, e3y)
+    return quadratic(coef, x - base[0][0], y - base[0][1]) * 8
 
 
-def _det_formula(ops, k, x, y, phi):
-    """det A / 8 = u1x (d2y w3 - w2 d3y) - u1y (d2x w3 - w2 d3x)."""
-    a1x, a1y = ops.base(k, 0)
-    u1x, u1y = x - a1x, y - a1y
-    d, w = [], []
-    for i in (1, 2):
-        ax, ay = ops.base(k, i)
-        rx, ry = ops.rot(phi, k, i)
-        d.append((rx - ax + a1x, ry - ay + a1y))
-        w.append(rx * (y - ay) - ry * (x - ax))
-    (d2x, d2y), (d3x, d3y) = d
-    w2, w3 = w
-    return u1x * (d2y * w3 - w2 * d3y) - u1y * (d2x * w3 - w2 * d3x)
+def _jacobian_rows(legs, zero) -> list[list]:
+    """A = dF/dX: row i = 2 (d_ix + r_ix, d_iy + r_iy, w_i); leg 1 has w_1 = ``zero``."""
+    rows = []
+    for dx, dy, rx, ry in legs:
+        if rx is None:
+            rows.append([dx * 2, dy * 2, zero])
+        else:
+            rows.append([(dx + rx) * 2, (dy + ry) * 2, leg_moment(dx, dy, rx, ry) * 2])
+    return rows
 
 
 # --------------------------------------------------------------------------------------
-# Float (approximate) versions
+# float64 (approximate: predictors, plots, tests; never a label)
 # --------------------------------------------------------------------------------------
-def _split_points(X: np.ndarray):
+def _float_legs(geometry: Geometry, X):
+    k = constants(geometry)
     X = np.asarray(X, dtype=np.float64)
-    return X[..., 0], X[..., 1], X[..., 2]
+    x, y, phi = X[..., 0], X[..., 1], X[..., 2]
+    base = list(zip(k.ax, k.ay))
+
+    def rotation(i, phi):
+        t = phi + k.alpha[i]
+        return k.radius[i] * np.cos(t), k.radius[i] * np.sin(t)
+
+    return base, _legs(base, rotation, x, y, phi), x, y
+
+
+def approx_rho_sq(geometry: Geometry, X: np.ndarray) -> np.ndarray:
+    """rho_i^2 in float64 for poses X of shape (..., 3); returns shape (..., 3). Not certified."""
+    _, legs, _, _ = _float_legs(geometry, X)
+    return np.stack([leg_rho_sq(*leg) for leg in legs], axis=-1)
 
 
 def approx_inverse_kinematics(geometry: Geometry, X: np.ndarray) -> np.ndarray:
     """rho = g(X) in float64 for poses X of shape (..., 3); returns shape (..., 3). Not certified."""
-    k = constants(geometry)
-    x, y, phi = _split_points(X)
-    return np.sqrt(np.stack(_rho_sq_formula(_FloatOps, k, x, y, phi), axis=-1))
+    return np.sqrt(approx_rho_sq(geometry, X))
 
 
 def approx_det_a(geometry: Geometry, X: np.ndarray) -> np.ndarray:
-    """det A in float64 for poses X of shape (..., 3). Not certified."""
-    k = constants(geometry)
-    x, y, phi = _split_points(X)
-    return 8.0 * _det_formula(_FloatOps, k, x, y, phi)
+    """det A in float64 for poses X of shape (..., 3); returns shape (...). Not certified."""
+    base, legs, x, y = _float_legs(geometry, X)
+    return _det(base, legs, x, y)
 
 
 def approx_jacobian(geometry: Geometry, X: np.ndarray) -> np.ndarray:
-    """A = dF/dX in float64, shape (..., 3, 3). Not certified."""
-    k = constants(geometry)
-    x, y, phi = _split_points(X)
-    rows = []
-    for i in range(3):
-        ux = x - k.ax[i]
-        uy = y - k.ay[i]
-        if i == 0:
-            rows.append(np.stack([2 * ux, 2 * uy, np.zeros_like(ux)], axis=-1))
-            continue
-        rx, ry = _FloatOps.rot(phi, k, i)
-        ux, uy = ux + rx, uy + ry
-        rows.append(np.stack([2 * ux, 2 * uy, 2 * (rx * uy - ry * ux)], axis=-1))
-    return np.stack(rows, axis=-2)
+    """A = dF/dX in float64 for poses X of shape (..., 3); returns shape (..., 3, 3). Not certified."""
+    _, legs, x, _ = _float_legs(geometry, X)
+    A = np.empty(np.shape(x) + (3, 3))
+    for i, row in enumerate(_jacobian_rows(legs, 0.0)):
+        for j, v in enumerate(row):
+            A[..., i, j] = v
+    return A
 
 
 # --------------------------------------------------------------------------------------
-# arb versions (the trusted reference)
+# arb (the trusted reference: balls at the current ctx.prec, wide arguments allowed)
 # --------------------------------------------------------------------------------------
-@functools.lru_cache(maxsize=32)
-def _arb_ops(geometry: Geometry, prec: int) -> _ArbOps:
-    return _ArbOps(geometry)
+def _arb_legs(geometry: Geometry, x, y, phi):
+    base, platform = constants(geometry).arb()
+    c, s = phi.cos(), phi.sin()
 
+    def rotation(i, phi):
+        px, py = platform[i]
+        return px * c - py * s, px * s + py * c
 
-def _ops_now(geometry: Geometry) -> _ArbOps:
-    from flint import ctx
-
-    return _arb_ops(geometry, ctx.prec)
-
-
-def inverse_kinematics_arb(geometry: Geometry, x, y, phi) -> list:
-    """[rho_1, rho_2, rho_3] as arb balls for arb inputs (at the current precision)."""
-    return [r.sqrt() for r in _rho_sq_formula(_ops_now(geometry), None, x, y, phi)]
+    return base, _legs(base, rotation, x, y, phi)
 
 
 def rho_sq_arb(geometry: Geometry, x, y, phi) -> list:
-    """[rho_1^2, rho_2^2, rho_3^2] as arb balls."""
-    return _rho_sq_formula(_ops_now(geometry), None, x, y, phi)
+    """[rho_1^2, rho_2^2, rho_3^2] as arb balls for arb arguments."""
+    _, legs = _arb_legs(geometry, x, y, phi)
+    return [leg_rho_sq(*leg) for leg in legs]
+
+
+def inverse_kinematics_arb(geometry: Geometry, x, y, phi) -> list:
+    """[rho_1, rho_2, rho_3] as arb balls for arb arguments."""
+    return [r.sqrt() for r in rho_sq_arb(geometry, x, y, phi)]
 
 
 def det_a_arb(geometry: Geometry, x, y, phi):
-    """det A as an arb ball."""
-    return 8 * _det_formula(_ops_now(geometry), None, x, y, phi)
+    """det A as an arb ball for arb arguments."""
+    base, legs = _arb_legs(geometry, x, y, phi)
+    return _det(base, legs, x, y)
 
 
 def residual_arb(geometry: Geometry, x, y, phi, rho_sq) -> list:
-    """F_i = |B_i - A_i|^2 - rho_i^2 as arb balls; rho_sq are arb balls (exact squares)."""
+    """F_i = |B_i - A_i|^2 - rho_i^2 as arb balls; ``rho_sq`` are arb balls (the exact squares)."""
     return [a - b for a, b in zip(rho_sq_arb(geometry, x, y, phi), rho_sq)]
 
 
 def jacobian_arb(geometry: Geometry, x, y, phi) -> list[list]:
-    """A = dF/dX as a 3x3 nested list of arb balls; arguments may be wide balls."""
-    ops = _ops_now(geometry)
-    rows = []
-    for i, ((ux, uy), r, _) in enumerate(_legs(ops, None, x, y, phi)):
-        if r is None:
-            rows.append([2 * ux, 2 * uy, 0 * ux])
-        else:
-            rx, ry = r
-            rows.append([2 * ux, 2 * uy, 2 * (rx * uy - ry * ux)])
-    return rows
-
-
-def _approx_f_and_jacobian(k: KinematicConstants, X: np.ndarray):
-    """Float rho_i^2 (m, 3) and A (m, 3, 3) at poses X (m, 3).  Not certified (predictors only)."""
-    x, y, phi = X[:, 0], X[:, 1], X[:, 2]
-    rsq = np.empty((len(X), 3))
-    A = np.zeros((len(X), 3, 3))
-    for i in range(3):
-        dx, dy = x - k.ax[i], y - k.ay[i]
-        if i == 0:
-            rx = ry = 0.0
-        else:
-            rx, ry = k.radius[i] * np.cos(phi + k.alpha[i]), k.radius[i] * np.sin(phi + k.alpha[i])
-        ux, uy = dx + rx, dy + ry
-        rsq[:, i] = ux * ux + uy * uy
-        A[:, i, 0], A[:, i, 1], A[:, i, 2] = 2 * ux, 2 * uy, 2 * (rx * dy - ry * dx)
-    return rsq, A
+    """A = dF/dX as a 3x3 nested list of arb balls; the arguments may be wide balls."""
+    _, legs = _arb_legs(geometry, x, y, phi)
+    return _jacobian_rows(legs, 0 * x)

@@ -108,6 +108,6 @@ def check_depth(depth, max_depth: int = MAX_DEPTH) -> int:
     have = available_memory_bytes()
     if need > have:
         raise ResourceError(
-            f"depth {depth}: estimated memory {need / 2**30:.1f} GiB exceeds available {have / 2**30:.1f} GiB; use a smaller --depth"
+            f"depth {depth}: estimated memory {need / 2**30:.1f} GiB exceeds available {have / 2**30:.1f} GiB; use a smaller depth"
         )
     return depth

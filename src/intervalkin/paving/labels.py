@@ -52,7 +52,7 @@ import enum
 
 import numpy as np
 
-__all__ = ['Label', 'and_labels', 'not_label']
+__all__ = ['Label', 'and_labels', 'not_label', 'signed_labels']
 
 
 class Label(enum.IntEnum):
@@ -82,3 +82,16 @@ def not_label(a: np.ndarray) -> np.ndarray:
     """Negation: INSIDE <-> OUTSIDE, BOUNDARY stays (swap the two flag bits)."""
     a = np.asarray(a, dtype=np.uint8)
     return (((a & 1) << 1) | ((a & 2) >> 1)).astype(np.uint8)
+
+
+def signed_labels(a: np.ndarray) -> np.ndarray:
+    """Label -> int8 as the output files write it: INSIDE 1, BOUNDARY 0, OUTSIDE -1.
+
+    >>> signed_labels(np.array([1, 2, 3], np.uint8))
+    array([-1,  1,  0], dtype=int8)
+    """
+    a = np.asarray(a)
+    out = np.zeros(a.shape, dtype=np.int8)
+    out[a == Label.INSIDE] = 1
+    out[a == Label.OUTSIDE] = -1
+    return out

@@ -1,46 +1,32 @@
-"""Tri-state predicates over arrays of boxes: joint limits (W), det A sign, aspects.
+"""Tri-state predicates over arrays of boxes: joint limits (W), sign of det A, the aspects.
 
-Every function here takes boxes of shape (n, 3, 2) (x, y, phi; phi in radians) and
-returns (n,) ``uint8`` :class:`~intervalkin.paving.labels.Label` arrays.  A label is made
-only from outward-rounded :class:`~intervalkin.core.interval.Interval` operations, never
-from a float comparison of approximate values.
+Every label function takes boxes of shape (n, 3, 2) ((x, y, phi) x (lo, hi); phi in
+radians) and returns an (n,) ``uint8`` array of :class:`~intervalkin.paving.labels.Label`:
 
-Tight enclosures (what decides the undecided layer)
----------------------------------------------------
+* W (the workspace, DESIGN.md section 4): rho_min_i <= rho_i <= rho_max_i for the three
+  legs.  Per leg, INSIDE when the enclosure of rho_i^2 lies in [rho_min_i^2, rho_max_i^2],
+  OUTSIDE when it lies strictly below or above it; W is the AND of the three legs
+  (OUTSIDE if one leg is, INSIDE only if all are).
+* det A sign: INSIDE where det A > 0 on the whole box, OUTSIDE where det A < 0 on the
+  whole box (both strict), BOUNDARY otherwise.
+* aspects: WA1 = W and det A > 0, WA2 = W and det A < 0 (section 2's sign convention).
 
-Both rho_i^2 and det A are, for fixed phi, polynomials of degree 2 in (x, y)
-(kinematics module docstring).  Write Q = det A / 8 with X = x - a1x, Y = y - a1y:
-
-    Q = a X^2 + b X Y + c Y^2 + d X + e Y,
-
-where a..e are trigonometric polynomials in phi (products of the components of
-r_2 = R(phi) p_2 and r_3 = R(phi) p_3 and the base offsets).  For every box:
-
-1. the phi-dependent coefficients are enclosed once per distinct phi interval of
-   the array (a paving level has at most 2**level of them), at the ends and the
-   middle of the phi interval (thin), and over the whole interval (hull over 8
-   sub-intervals), together with their phi-derivatives (forward mode);
-2. a quadratic with given coefficients is enclosed over the (x, y) rectangle by its
-   exact Taylor expansion at the centre, Q(m) + grad Q(m).(u, v) + a u^2 + b u v
-   + c v^2 (no gradient overestimation; only the u v term is loose);
-3. three sound enclosures are intersected: the centred form in phi
-   Q(x, y, phi_m) + dQ/dphi(box) (phi - phi_m); the natural form in phi (coefficient
-   ranges); and, where dQ/dphi(box) has a certified sign, monotonicity in phi
-   (the minimum and maximum lie on the faces phi = phi_lo, phi = phi_hi).
-
-rho_i^2 = (x - a_ix + r_ix)^2 + (y - a_iy + r_iy)^2 gets the same treatment: its
-phi-derivative is 2 (r_ix (y - a_iy) - r_iy (x - a_ix)), linear in (x, y), and for
-fixed phi the two squares are enclosed exactly.
+Certified: a label comes only from comparisons of outward-rounded enclosures
+(:func:`intervalkin.kinematics.enclosures.rho_sq_interval`,
+:func:`~intervalkin.kinematics.enclosures.det_a_interval`, the phi-tight forms) with
+outward enclosures of the exact squared limits, never from a float value.  INSIDE
+means the predicate holds at every point of the box (closed box), OUTSIDE that it fails
+at every point; BOUNDARY claims nothing.  ``tests/test_predicate_properties.py``
+samples points of labelled boxes and checks each label in arb.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.interval import Interval
-from intervalkin.kinematics.quadratic import _det_q_tight, rho_sq_tight
+from intervalkin.kinematics.constants import constants
+from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_interval
 from intervalkin.paving.labels import Label, and_labels, not_label
 from intervalkin.paving.tree import Paving, pave_multi, workspace_paving_domain
 
@@ -50,37 +36,27 @@ __all__ = ['workspace_labels', 'det_sign_labels', 'aspect_labels', 'workspace_pr
 # --------------------------------------------------------------------------------------
 # Labels
 # --------------------------------------------------------------------------------------
-def _limit_sq_bounds(geometry: Geometry):
-    mins = [fraction_bounds(v * v) for v in geometry.rho_min]
-    maxs = [fraction_bounds(v * v) for v in geometry.rho_max]
-    return mins, maxs
-
-
-def _limit_label(geometry: Geometry, r: Interval, leg: int) -> np.ndarray:
-    mins, maxs = _limit_sq_bounds(geometry)
-    (mn_lo, mn_hi), (mx_lo, mx_hi) = mins[leg], maxs[leg]
-    lab = np.full(r.lo.shape, Label.BOUNDARY, dtype=np.uint8)
-    lab[(r.lo >= mn_hi) & (r.hi <= mx_lo)] = Label.INSIDE
-    lab[(r.hi < mn_lo) | (r.lo > mx_hi)] = Label.OUTSIDE
-    return lab
-
-
 def workspace_labels(geometry: Geometry, boxes: np.ndarray) -> np.ndarray:
     """W: rho_min_i <= rho_i <= rho_max_i for i = 1, 2, 3 (the AND of the three legs)."""
-    rs = rho_sq_tight(geometry, boxes)
-    lab = _limit_label(geometry, rs[0], 0)
-    for i in (1, 2):
-        lab = and_labels(lab, _limit_label(geometry, rs[i], i))
+    k = constants(geometry)
+    r = rho_sq_interval(geometry, boxes)
+    lab = None
+    for i in range(3):
+        lo, hi = r.lo[:, i], r.hi[:, i]
+        leg = np.full(lo.shape, Label.BOUNDARY, dtype=np.uint8)
+        leg[(lo >= k.rho_min_sq_iv.hi[i]) & (hi <= k.rho_max_sq_iv.lo[i])] = Label.INSIDE
+        leg[(hi < k.rho_min_sq_iv.lo[i]) | (lo > k.rho_max_sq_iv.hi[i])] = Label.OUTSIDE
+        lab = leg if lab is None else and_labels(lab, leg)
     return lab
 
 
 def det_sign_labels(geometry: Geometry, boxes: np.ndarray) -> np.ndarray:
     """Sign of det A as a label: INSIDE where det A > 0 on the whole box, OUTSIDE where
     det A < 0 on the whole box (strict both ways), BOUNDARY otherwise."""
-    q = _det_q_tight(geometry, boxes)
-    lab = np.full(q.lo.shape, Label.BOUNDARY, dtype=np.uint8)
-    lab[q.lo > 0] = Label.INSIDE
-    lab[q.hi < 0] = Label.OUTSIDE
+    d = det_a_interval(geometry, boxes)
+    lab = np.full(d.lo.shape, Label.BOUNDARY, dtype=np.uint8)
+    lab[d.lo > 0] = Label.INSIDE
+    lab[d.hi < 0] = Label.OUTSIDE
     return lab
 
 

@@ -49,10 +49,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.interval import PI_HI, PI_LO, Interval
-from intervalkin.kinematics.constants import _k
-from intervalkin.kinematics.enclosures import jacobian_enclosure, rho_sq_enclosure
-from intervalkin.kinematics.formulas import _approx_f_and_jacobian
+from intervalkin.core.interval import PI_HI, PI_LO, Interval, round_down, round_up
+from intervalkin.kinematics.constants import constants
+from intervalkin.kinematics.enclosures import jacobian_interval, rho_sq_interval
+from intervalkin.kinematics.formulas import approx_jacobian, approx_rho_sq
 
 #: Steps are halved down to this fraction of the segment, then the track gives up.
 MIN_STEP = 2.0**-14
@@ -67,7 +67,7 @@ TINY = 1e-9
 
 def _step_scale(geometry: Geometry) -> np.ndarray:
     """Length scale of each pose coordinate: 1 for x and y, 1 / (largest platform radius) for phi."""
-    k = _k(geometry)
+    k = constants(geometry)
     return np.array([1.0, 1.0, 1.0 / max(float(np.max(k.radius)), 1.0)])
 
 
@@ -110,7 +110,7 @@ def krawczyk_segment(geometry: Geometry, lo, hi, qa: Interval, qb: Interval, t0,
     m = Interval(lo, hi).mid()
     dq = qb - qa
     with np.errstate(all="ignore"):
-        A = _approx_f_and_jacobian(_k(geometry), m)[1]
+        A = approx_jacobian(geometry, m)
         good = np.isfinite(A).all(axis=(1, 2)) & (np.abs(np.linalg.det(A)) > 0)
         A[~good] = np.eye(3)
         Y = np.linalg.inv(A)
@@ -118,12 +118,12 @@ def krawczyk_segment(geometry: Geometry, lo, hi, qa: Interval, qb: Interval, t0,
     Y[~good] = 0.0
     tm = 0.5 * t0 + 0.5 * t1
     tm = np.minimum(np.maximum(tm, t0), t1)
-    rsq_m = rho_sq_enclosure(geometry, m, m)
+    rsq_m = rho_sq_interval(geometry, np.stack([m, m], axis=-1))
     F_m = rsq_m - _q_at(qa, dq, tm).sqr()
     T = Interval(t0, t1)
     dF = _q_at(qa, dq, T) * dq * (-2.0)
     S = T - Interval.point(tm)
-    J = jacobian_enclosure(geometry, lo, hi)
+    J = jacobian_interval(geometry, np.stack([lo, hi], axis=-1))
     M = Interval.point(np.eye(3)) - _matmat(Y, J)
     box = Interval(lo, hi)
     D = box - m
@@ -133,7 +133,7 @@ def krawczyk_segment(geometry: Geometry, lo, hi, qa: Interval, qb: Interval, t0,
     with np.errstate(all="ignore"):
         ratio = np.max((K.hi - K.lo) / np.maximum(hi - lo, 1e-300), axis=1)
     p = m if p_end is None else np.minimum(np.maximum(np.asarray(p_end, dtype=np.float64), lo), hi)
-    F_p = rho_sq_enclosure(geometry, p, p) - _q_at(qa, dq, t1).sqr()
+    F_p = rho_sq_interval(geometry, np.stack([p, p], axis=-1)) - _q_at(qa, dq, t1).sqr()
     K1 = (Interval.point(p) - _matvec(Y, F_p)) + _matvec(M, box - p)
     z_lo = np.maximum(K1.lo, lo)
     z_hi = np.minimum(K1.hi, hi)
@@ -147,13 +147,12 @@ def krawczyk_segment(geometry: Geometry, lo, hi, qa: Interval, qb: Interval, t0,
 
 def _newton(geometry: Geometry, x: np.ndarray, q: np.ndarray, iters: int = 4):
     """Float Newton on F(X) = rho(X)^2 - q^2 from x (m, 3); returns (x, converged)."""
-    k = _k(geometry)
     x = np.array(x, dtype=np.float64)
     q2 = q * q
     conv = np.zeros(len(x), dtype=bool)
     with np.errstate(all="ignore"):
         for _ in range(iters):
-            rsq, A = _approx_f_and_jacobian(k, x)
+            rsq, A = approx_rho_sq(geometry, x), approx_jacobian(geometry, x)
             ok = np.isfinite(A).all(axis=(1, 2)) & (np.abs(np.linalg.det(A)) > 1e-12)
             A[~ok] = np.eye(3)
             dx = np.linalg.solve(A, (rsq - q2)[..., None])[..., 0]
@@ -203,7 +202,7 @@ def step_tracks(geometry: Geometry, tr: Tracks, idx: np.ndarray) -> None:
     p0 = tr.p[idx]
     # tangent predictor: dX/dt = A^-1 (2 rho(t) dq)
     with np.errstate(all="ignore"):
-        A = _approx_f_and_jacobian(_k(geometry), p0)[1]
+        A = approx_jacobian(geometry, p0)
         rhs = 2.0 * _q_float(qa, dq, t0) * dq.mid()
         try:
             tan = np.linalg.solve(A, rhs[..., None])[..., 0]
@@ -219,11 +218,11 @@ def step_tracks(geometry: Geometry, tr: Tracks, idx: np.ndarray) -> None:
     scale = _step_scale(geometry)
     spread = (delta / scale).max(axis=1, keepdims=True) * scale
     r = MARGIN_OWN * delta + MARGIN_ALL * spread + 1e-9 * (1.0 + np.abs(c))
-    lo = np.nextafter(np.minimum(c - r, tr.z_lo[idx]), -np.inf)
-    hi = np.nextafter(np.maximum(c + r, tr.z_hi[idx]), np.inf)
+    lo = round_down(np.minimum(c - r, tr.z_lo[idx]))
+    hi = round_up(np.maximum(c + r, tr.z_hi[idx]))
     # one call: the step box over [t0, t1], and a tiny box around p1 at t1 alone
     eps = TINY * (1.0 + np.abs(p1))
-    tlo, thi = np.nextafter(p1 - eps, -np.inf), np.nextafter(p1 + eps, np.inf)
+    tlo, thi = round_down(p1 - eps), round_up(p1 + eps)
     m = idx.size
     both = np.concatenate([np.arange(m), np.arange(m)])
     ok2, zl2, zh2, ratio = krawczyk_segment(geometry, np.concatenate([lo, tlo]), np.concatenate([hi, thi]),
@@ -278,7 +277,7 @@ def certify_start(geometry: Geometry, q: Interval, x: np.ndarray, radius: float 
     """
     p, conv = _newton(geometry, x, q.mid())
     r = radius * (1.0 + np.abs(p))
-    lo, hi = np.nextafter(p - r, -np.inf), np.nextafter(p + r, np.inf)
+    lo, hi = round_down(p - r), round_up(p + r)
     z = np.zeros(len(p))
     ok, zl, zh = krawczyk_segment(geometry, lo, hi, q, q, z, z, p_end=p)
     return ok & conv, lo, hi, p

@@ -73,9 +73,14 @@ the image g(S) of the singular surface (a double root) always ends this way:
 the solver never returns an unproved count.
 
 The sign of det A is proved on each unique box by an arb evaluation over the box
-(:func:`kinematics.det_a_arb`); should that enclosure meet 0, the Krawczyk
-inclusion itself proves every Jacobian in the box non-singular, so the sign at
-the midpoint (evaluated in arb) is the sign over the whole box.
+(:func:`intervalkin.kinematics.formulas.det_a_arb`); should that enclosure meet
+0, the Krawczyk inclusion itself proves every Jacobian in the box non-singular,
+so the sign at the midpoint (evaluated in arb) is the sign over the whole box.
+
+The reduction is written in :mod:`intervalkin.kinematics.sextic`, the Krawczyk
+test in :mod:`intervalkin.solve.krawczyk`, the result types in
+:mod:`intervalkin.solve.solutions`; this module reads the joint vector and
+runs the certification above, raising the precision until it succeeds.
 """
 
 from __future__ import annotations
@@ -87,6 +92,7 @@ from fractions import Fraction
 from typing import Sequence
 
 import numpy as np
+from flint import acb_poly, arb, ctx, fmpq
 
 from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
@@ -97,9 +103,10 @@ from intervalkin.kinematics.sextic import (
     _reduce,
     _Reduction,
 )
-from intervalkin.solve.krawczyk import _TWO_PI, _box_of, _disjoint, _krawczyk
+from intervalkin.solve.krawczyk import box_bounds, disjoint_mod_2pi, krawczyk
+from intervalkin.solve.solutions import DkpResult, DkpSolution
 
-__all__ = ['PRECISIONS', 'MAX_WIDTH', 'parse_joint_vector', 'DkpSolution', 'DkpResult', 'solve']
+__all__ = ['PRECISIONS', 'MAX_WIDTH', 'parse_joint_vector', 'solve']
 
 #: Working precisions tried in turn (bits); the last one is the ceiling.
 PRECISIONS: tuple[int, ...] = (64, 128, 256, 512)
@@ -107,19 +114,20 @@ PRECISIONS: tuple[int, ...] = (64, 128, 256, 512)
 MAX_WIDTH = 1e-9
 
 
-
 # --------------------------------------------------------------------------------------
 # Input
 # --------------------------------------------------------------------------------------
-def parse_joint_vector(geometry: Geometry, values: Sequence[str]) -> tuple[Fraction, Fraction, Fraction]:
-    """Read three leg lengths as exact decimals and check them against the joint limits.
+def parse_joint_vector(geometry: Geometry, values: Sequence) -> tuple[Fraction, Fraction, Fraction]:
+    """Read three leg lengths exactly and check them against the joint limits.
 
     Parameters
     ----------
     geometry : Geometry
         Supplies the limits [rho_min_i, rho_max_i].
-    values : sequence of three str
-        Decimal numbers such as ``"14.98"`` (read exactly: 14.98 is 1498/100).
+    values : sequence of three values
+        Exact numbers (Fraction or int, taken as they are) or decimal text such
+        as ``"14.98"`` (read exactly: 14.98 is 1498/100); any other value is
+        read through its text (a float 14.98 through ``"14.98"``).
 
     Returns
     -------
@@ -139,13 +147,16 @@ def parse_joint_vector(geometry: Geometry, values: Sequence[str]) -> tuple[Fract
         leg = f"rho_{i + 1}"
         lo, hi = geometry.rho_min[i], geometry.rho_max[i]
         allowed = f"[{_fmt_fraction(lo)}, {_fmt_fraction(hi)}]"
-        try:
-            d = Decimal(str(text).strip())
-        except (InvalidOperation, ValueError):
-            raise InputError(f"{leg}: expected a decimal number in {allowed}, got {text!r}") from None
-        if not d.is_finite():
-            raise InputError(f"{leg}: expected a finite number in {allowed}, got {text!r}")
-        v = Fraction(d)
+        if isinstance(text, (Fraction, int)) and not isinstance(text, bool):
+            v = Fraction(text)
+        else:
+            try:
+                d = Decimal(str(text).strip())
+            except (InvalidOperation, ValueError):
+                raise InputError(f"{leg}: expected a decimal number in {allowed}, got {text!r}") from None
+            if not d.is_finite():
+                raise InputError(f"{leg}: expected a finite number in {allowed}, got {text!r}")
+            v = Fraction(d)
         if not lo <= v <= hi:
             raise InputError(f"{leg}: {text} is outside the joint limits {allowed}")
         out.append(v)
@@ -153,6 +164,7 @@ def parse_joint_vector(geometry: Geometry, values: Sequence[str]) -> tuple[Fract
 
 
 def _fmt_fraction(q: Fraction) -> str:
+    """A limit for messages: the integer, or its decimal expansion (28 significant digits at most)."""
     if q.denominator == 1:
         return str(q.numerator)
     d = Decimal(q.numerator) / Decimal(q.denominator)
@@ -160,109 +172,28 @@ def _fmt_fraction(q: Fraction) -> str:
 
 
 # --------------------------------------------------------------------------------------
-# Results
-# --------------------------------------------------------------------------------------
-@dataclass(frozen=True, eq=False)
-class DkpSolution:
-    """One assembly mode.
-
-    Attributes
-    ----------
-    box : ndarray of shape (3, 2), float64
-        Rows (x, y, phi), columns (lo, hi).  For status ``"unique"`` the box is
-        PROVED to contain exactly one solution of F = 0 (phi read modulo 2 pi) and
-        is narrower than :data:`MAX_WIDTH`.  The phi interval meets (-pi, pi];
-        when it holds the seam it is written around +pi and exceeds pi by less
-        than its width (the solution is then within that width of phi = pi).  For ``"unknown"`` the box is where the
-        float solver points; nothing is claimed about it.
-    det_sign : int
-        1 or -1: sign of det A PROVED on the whole box; 0: not proved.
-    aspect : str or None
-        ``"WA1"`` (det A > 0), ``"WA2"`` (det A < 0) or None.
-    status : str
-        ``"unique"`` or ``"unknown"``.
-    reason : str
-        Why an unknown box could not be proved ("" for unique ones).
-    """
-
-    box: np.ndarray
-    det_sign: int
-    aspect: str | None
-    status: str
-    reason: str = ""
-
-    @property
-    def midpoint(self) -> np.ndarray:
-        """(x, y, phi) at the box centre (float; approximate)."""
-        return 0.5 * (self.box[:, 0] + self.box[:, 1])
-
-    @property
-    def width(self) -> float:
-        """Largest side of the box."""
-        return float(np.max(self.box[:, 1] - self.box[:, 0]))
-
-    def to_json(self) -> dict:
-        d = {
-            "x": [float(self.box[0, 0]), float(self.box[0, 1])],
-            "y": [float(self.box[1, 0]), float(self.box[1, 1])],
-            "phi": [float(self.box[2, 0]), float(self.box[2, 1])],
-            "det_sign": int(self.det_sign),
-            "aspect": self.aspect,
-            "status": self.status,
-        }
-        if self.status != "unique":
-            d["reason"] = self.reason
-        return d
-
-
-@dataclass(frozen=True, eq=False)
-class DkpResult:
-    """Every assembly mode of one joint vector, with the status of the claim.
-
-    Attributes
-    ----------
-    rho : three Fractions, the exact leg lengths solved for.
-    solutions : tuple of DkpSolution, sorted by increasing phi midpoint.
-    complete : bool
-        True when it is PROVED that the unique boxes hold ALL the real solutions
-        (one each, no others anywhere in R^2 x S^1).  False otherwise; then the
-        listed unique boxes are still each proved, but the list may miss
-        solutions or contain unknown boxes.
-    completeness_reason : str
-        How completeness was proved, or why it could not be.
-    precision : int
-        The arb working precision (bits) of the last attempt.
-    """
-
-    rho: tuple[Fraction, Fraction, Fraction]
-    solutions: tuple[DkpSolution, ...]
-    complete: bool
-    completeness_reason: str
-    precision: int
-
-    @property
-    def count(self) -> int:
-        """Number of listed solutions (the certified count only when ``complete``)."""
-        return len(self.solutions)
-
-    def to_json(self) -> dict:
-        """``{"rho", "count", "complete", "solutions"}`` as plain JSON types."""
-        return {
-            "rho": [float(r) for r in self.rho],
-            "count": self.count,
-            "complete": bool(self.complete),
-            "solutions": [s.to_json() for s in self.solutions],
-        }
-
-
-def _solution(K, sign: int) -> DkpSolution:
-    aspect = "WA1" if sign > 0 else ("WA2" if sign < 0 else None)
-    return DkpSolution(box=_box_of(K), det_sign=sign, aspect=aspect, status="unique")
-
-
-# --------------------------------------------------------------------------------------
 # One attempt at one precision
 # --------------------------------------------------------------------------------------
+def _solution(K, sign: int) -> DkpSolution:
+    aspect = "WA1" if sign > 0 else ("WA2" if sign < 0 else None)
+    return DkpSolution(box=box_bounds(K), det_sign=sign, aspect=aspect, status="unique")
+
+
+def _add_if_disjoint(sols: list, s: DkpSolution) -> None:
+    """Append ``s`` unless it may overlap a box already in ``sols``."""
+    if all(disjoint_mod_2pi(s.box, o.box) for o in sols):
+        sols.append(s)
+
+
+def _lift(red: _Reduction, pm) -> np.ndarray:
+    """The float pose (x, y, phi) of the solution at the angle ``pm`` (an arb point): z = N / D."""
+    Nm = _leval(red.N, pm)
+    Dm = _leval(red.D, pm).real
+    x = red.a1[0] + Nm.real / Dm
+    y = red.a1[1] + Nm.imag / Dm
+    return np.array([float(x.mid()), float(y.mid()), math.remainder(float(pm.mid()), math.tau)])
+
+
 @dataclass
 class _Attempt:
     solutions: list
@@ -272,8 +203,6 @@ class _Attempt:
 
 
 def _attempt(geometry: Geometry, rho, rho_sq, prec: int) -> _Attempt:
-    from flint import acb_poly, arb
-
     red = _reduce(geometry, rho_sq)
     shift = _choose_shift(red)
     if shift is None:
@@ -307,24 +236,22 @@ def _attempt(geometry: Geometry, rho, rho_sq, prec: int) -> _Attempt:
         if _leval(red.D, phi).real.contains(0):
             return _Attempt([], False, f"2x2 linear system may be singular at a root phi ~ {float(phi.mid()):.6g} "
                             f"of the reduced equation ({prec} bits)", _float_candidates(coeffs, phi0, red))
-        pm = phi.mid()
-        Nm = _leval(red.N, pm)
-        Dm = _leval(red.D, pm).real
-        x = red.a1[0] + Nm.real / Dm
-        y = red.a1[1] + Nm.imag / Dm
-        starts.append(np.array([float(x.mid()), float(y.mid()), math.remainder(float(pm.mid()), _TWO_PI)]))
+        starts.append(_lift(red, phi.mid()))
     sols = []
     failures = []
     for s in starts:
-        got, why = _krawczyk(geometry, rho_sq, s, prec)
+        got, why = krawczyk(geometry, rho_sq, s, prec)
         if got is None:
             failures.append((s, why))
         else:
             sols.append(_solution(*got))
     for a in range(len(sols)):
         for b in range(a + 1, len(sols)):
-            if not _disjoint(sols[a].box, sols[b].box):
-                return _Attempt(_dedupe(sols), False, f"two certified boxes could not be separated at {prec} bits",
+            if not disjoint_mod_2pi(sols[a].box, sols[b].box):
+                kept: list = []
+                for s in sols:
+                    _add_if_disjoint(kept, s)
+                return _Attempt(kept, False, f"two certified boxes could not be separated at {prec} bits",
                                 [f[0] for f in failures])
     if failures:
         return _Attempt(sols, False, f"{len(failures)} of {n_real} real roots not certified by Krawczyk at "
@@ -336,18 +263,8 @@ def _attempt(geometry: Geometry, rho, rho_sq, prec: int) -> _Attempt:
                     f"each, {len(sols)} disjoint Krawczyk boxes", [])
 
 
-def _dedupe(sols: list) -> list:
-    out: list = []
-    for s in sols:
-        if all(_disjoint(s.box, o.box) for o in out):
-            out.append(s)
-    return out
-
-
 def _float_candidates(coeffs, phi0: float, red: _Reduction) -> list:
     """Approximate solutions from the float roots of P (for the fallback only)."""
-    from flint import arb
-
     c = np.array([float(v.mid()) for v in coeffs])[::-1]
     while len(c) > 1 and c[0] == 0.0:
         c = c[1:]
@@ -357,15 +274,10 @@ def _float_candidates(coeffs, phi0: float, red: _Reduction) -> list:
     for t in np.roots(c):
         if abs(t.imag) > 1e-4 * (1.0 + abs(t)):
             continue
-        phi = phi0 + 2.0 * math.atan(t.real)
-        pm = arb(phi)
-        Dm = _leval(red.D, pm).real
-        if Dm.contains(0):
+        pm = arb(phi0 + 2.0 * math.atan(t.real))
+        if _leval(red.D, pm).real.contains(0):
             continue
-        Nm = _leval(red.N, pm)
-        x = red.a1[0] + Nm.real / Dm
-        y = red.a1[1] + Nm.imag / Dm
-        out.append(np.array([float(x.mid()), float(y.mid()), math.remainder(phi, _TWO_PI)]))
+        out.append(_lift(red, pm))
     return out
 
 
@@ -404,8 +316,6 @@ def solve(geometry: Geometry, rho: Sequence[Fraction]) -> DkpResult:
     >>> r.count, r.complete, [s.aspect for s in r.solutions]
     (6, True, ['WA2', 'WA1', 'WA1', 'WA2', 'WA2', 'WA1'])
     """
-    from flint import arb, ctx, fmpq
-
     rho_f = tuple(Fraction(r) for r in rho)
     if len(rho_f) != 3:
         raise InputError(f"joint vector: expected 3 leg lengths, got {len(rho_f)}")
@@ -424,16 +334,12 @@ def solve(geometry: Geometry, rho: Sequence[Fraction]) -> DkpResult:
         att, prec, rho_sq = last  # type: ignore[misc]
         sols = list(att.solutions)
         for start in att.candidates:
-            got, why = _krawczyk(geometry, rho_sq, start, prec)
+            got, why = krawczyk(geometry, rho_sq, start, prec)
             if got is not None:
-                s = _solution(*got)
-                if all(_disjoint(s.box, o.box) for o in sols):
-                    sols.append(s)
+                _add_if_disjoint(sols, _solution(*got))
                 continue
             box = np.array([[v - 1e-6, v + 1e-6] for v in start])
-            s = DkpSolution(box=box, det_sign=0, aspect=None, status="unknown", reason=why)
-            if all(_disjoint(s.box, o.box) for o in sols):
-                sols.append(s)
+            _add_if_disjoint(sols, DkpSolution(box=box, det_sign=0, aspect=None, status="unknown", reason=why))
         return _result(rho_f, sols, False, att.reason, prec)
     finally:
         ctx.prec = old

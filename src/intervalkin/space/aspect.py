@@ -1,36 +1,15 @@
-"""Tri-state predicates over arrays of boxes: joint limits (W), det A sign, aspects.
+"""Aspects: the connected components of W on which det A keeps one certified sign.
 
-Every function here takes boxes of shape (n, 3, 2) (x, y, phi; phi in radians) and
-returns (n,) ``uint8`` :class:`~intervalkin.paving.labels.Label` arrays.  A label is made
-only from outward-rounded :class:`~intervalkin.core.interval.Interval` operations, never
-from a float comparison of approximate values.
+Definition (the paper's section 3.1; DESIGN.md section 2): an aspect is a
+connected component of the workspace W minus the type-2 singular surface
+det A = 0.  With the sign convention of DESIGN.md, WA1 has det A > 0 and WA2
+det A < 0.
 
-Tight enclosures (what decides the undecided layer)
----------------------------------------------------
-
-Both rho_i^2 and det A are, for fixed phi, polynomials of degree 2 in (x, y)
-(kinematics module docstring).  Write Q = det A / 8 with X = x - a1x, Y = y - a1y:
-
-    Q = a X^2 + b X Y + c Y^2 + d X + e Y,
-
-where a..e are trigonometric polynomials in phi (products of the components of
-r_2 = R(phi) p_2 and r_3 = R(phi) p_3 and the base offsets).  For every box:
-
-1. the phi-dependent coefficients are enclosed once per distinct phi interval of
-   the array (a paving level has at most 2**level of them), at the ends and the
-   middle of the phi interval (thin), and over the whole interval (hull over 8
-   sub-intervals), together with their phi-derivatives (forward mode);
-2. a quadratic with given coefficients is enclosed over the (x, y) rectangle by its
-   exact Taylor expansion at the centre, Q(m) + grad Q(m).(u, v) + a u^2 + b u v
-   + c v^2 (no gradient overestimation; only the u v term is loose);
-3. three sound enclosures are intersected: the centred form in phi
-   Q(x, y, phi_m) + dQ/dphi(box) (phi - phi_m); the natural form in phi (coefficient
-   ranges); and, where dQ/dphi(box) has a certified sign, monotonicity in phi
-   (the minimum and maximum lie on the faces phi = phi_lo, phi = phi_hi).
-
-rho_i^2 = (x - a_ix + r_ix)^2 + (y - a_iy + r_iy)^2 gets the same treatment: its
-phi-derivative is 2 (r_ix (y - a_iy) - r_iy (x - a_ix)), linear in (x, y), and for
-fixed phi the two squares are enclosed exactly.
+Certified here: each component of face-adjacent boxes certified inside W with
+one sign of det A is connected and lies in one aspect; components of opposite
+signs lie in different aspects (the sign is the witness).  Not certified: that
+two components of one sign are different aspects (they may join through the
+undecided layer), nor that no aspect hides wholly in that layer.
 """
 
 from __future__ import annotations
@@ -41,7 +20,10 @@ from intervalkin.paving.adjacency import component_labels, shares_face
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 
-__all__ = ['aspect_components']
+__all__ = ['ASPECTS', 'aspect_components']
+
+#: The aspects' names: WA1 where det A > 0, WA2 where det A < 0.
+ASPECTS = ("WA1", "WA2")
 
 
 def aspect_components(paving: Paving, edges: np.ndarray | None = None):
@@ -87,5 +69,3 @@ def aspect_components(paving: Paving, edges: np.ndarray | None = None):
         base += ncomp
     return aspect, info
 
-
-ASPECTS = ("WA1", "WA2")

@@ -39,8 +39,9 @@ import numpy as np
 
 from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import Interval
 from intervalkin.paving.adjacency import component_labels, grow_labels
-from intervalkin.solve.dkp import parse_joint_vector, solve
+from intervalkin.solve.dkp import solve
 from intervalkin.space.singular_surface import singular_image
 
 __all__ = ['JointCell', 'JointPaving', 'joint_paving']
@@ -115,7 +116,16 @@ class JointPaving:
 
     @property
     def n(self) -> int:
+        """Voxels per axis, 2**depth."""
         return 1 << self.depth
+
+    def approx_grid(self) -> tuple[np.ndarray, np.ndarray]:
+        """rho_min and the voxel step as floats (3,) each: for index guesses and plots, never a proof."""
+        return np.array([float(v) for v in self.rho_min]), np.array([float(v) for v in self.step])
+
+    def voxel_centre(self, idx) -> tuple[Fraction, Fraction, Fraction]:
+        """The exact centre rho_min + (k + 1/2) step of the voxel with indices ``idx`` (3 ints)."""
+        return _voxel_centre(self.rho_min, self.step, idx)
 
     def voxel_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Float bounds (N^3, 3) of every voxel, C order, rounded outward."""
@@ -124,9 +134,9 @@ class JointPaving:
         lo = np.empty(idx.shape)
         hi = np.empty(idx.shape)
         for i in range(3):
-            r0, h = float(self.rho_min[i]), float(self.step[i])
-            lo[:, i] = np.nextafter(r0 + idx[:, i] * h, -np.inf)
-            hi[:, i] = np.nextafter(r0 + (idx[:, i] + 1) * h, np.inf)
+            edges = Interval.from_exact(self.rho_min[i] + k * self.step[i] for k in range(n + 1))
+            lo[:, i] = edges.lo[idx[:, i]]
+            hi[:, i] = edges.hi[idx[:, i] + 1]
         return lo, hi
 
     def index_ranges(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -136,8 +146,7 @@ class JointPaving:
         the joint box entirely (their ranges are then meaningless).
         """
         n = self.n
-        r0 = np.array([float(v) for v in self.rho_min])
-        h = np.array([float(v) for v in self.step])
+        r0, h = self.approx_grid()
         tlo = (lo - r0) / h
         thi = (hi - r0) / h
         inside = np.all((thi >= -_INDEX_MARGIN) & (tlo <= n + _INDEX_MARGIN), axis=1)
@@ -152,8 +161,7 @@ class JointPaving:
         """
         ilo, ihi, inside = self.index_ranges(lo, hi)
         n = self.n
-        r0 = np.array([float(v) for v in self.rho_min])
-        h = np.array([float(v) for v in self.step])
+        r0, h = self.approx_grid()
         within = np.all((lo >= r0) & (hi <= r0 + n * h), axis=1)
         total = _range_sum(self.prefix, ilo, ihi)
         return ~(inside & within) | (total > 0)
@@ -209,6 +217,10 @@ class JointPaving:
         voxel = float(np.prod([float(s) for s in self.step]))
         out["undecided"] = float(self.marked.sum()) * voxel
         return out
+
+
+def _voxel_centre(rho_min, step, idx) -> tuple[Fraction, Fraction, Fraction]:
+    return tuple(rho_min[i] + (int(idx[i]) + Fraction(1, 2)) * step[i] for i in range(3))  # type: ignore[return-value]
 
 
 def _range_sum(prefix: np.ndarray, ilo: np.ndarray, ihi: np.ndarray) -> np.ndarray:
@@ -347,7 +359,7 @@ def joint_paving(
         if solved < max_solves:
             for attempt in range(3):
                 vox = _representative_voxel(cell_grid, cid, rng, attempt)
-                q = tuple(rho_min[i] + (Fraction(int(vox[i])) + Fraction(1, 2)) * step[i] for i in range(3))
+                q = _voxel_centre(rho_min, step, vox)
                 res = solve(geometry, q)
                 solved += 1
                 if res.complete and all(s.status == "unique" and s.det_sign != 0 for s in res.solutions):
@@ -365,24 +377,3 @@ def joint_paving(
     joinable = _joinable_pairs(cell_grid, marked, [c.count for c in cells])
     return JointPaving(geometry, depth, rho_min, step, marked, prefix, cell_grid, tuple(cells),  # type: ignore[arg-type]
                        int(len(singular_boxes)), time.perf_counter() - t0, joinable)
-
-
-def solution_count(geometry: Geometry, rho: Sequence, paving: JointPaving | None = None) -> tuple[int, int, int, str]:
-    """Certified number of direct-kinematic solutions of q, and its split (WA1, WA2).
-
-    Answered from the cell paving when q lies in a solved cell, else by a
-    certified solve.  Returns (count, n_wa1, n_wa2, source) with source "cell k"
-    or "solve"; raises :class:`InputError` when the solve cannot be certified.
-    """
-
-    q = parse_joint_vector(geometry, [str(v) for v in rho])
-    if paving is not None:
-        cid = paving.cell_at(q)
-        if cid >= 0 and paving.cells[cid].count >= 0:
-            c = paving.cells[cid]
-            return c.count, c.n_wa1, c.n_wa2, f"cell {cid}"
-    res = solve(geometry, q)
-    if not res.complete or any(s.status != "unique" for s in res.solutions):
-        raise InputError(f"rho = {[float(v) for v in q]}: the solution count cannot be certified here (near g(S))")
-    n1 = sum(1 for s in res.solutions if s.det_sign > 0)
-    return len(res.solutions), n1, len(res.solutions) - n1, "solve"

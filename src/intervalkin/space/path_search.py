@@ -1,72 +1,26 @@
-"""Certified non-singular trajectories between assembly modes of one aspect.
+"""Proposing a motion through a workspace paving: a shortest box path, its waypoints, and smoothing.
 
-The paper (section 3.2, Table 1) observes that solutions 2, 3 and 6 of the joint
-vector rho = (14.98, 15.38, 12.0) lie in one aspect WA1, so the platform can move
-from one to another without meeting a type-2 singularity; section 5.2 and
-Figure 13 add that such a motion must pass through an intermediate basic region,
-whose image is a joint-space domain with only two solutions.  This module builds
-such a motion and PROVES it non-singular.
+Nothing here certifies anything: the paving only PROPOSES the path, which
+:func:`intervalkin.space.segment.certify_segment` then proves segment by segment.
 
-Construction
-------------
-1. The two solutions are the certified direct-kinematic boxes of
-   :func:`dkp.solve` (numbered from 1 in increasing phi, as ``intervalkin dkp``
-   prints them).  Opposite certified signs of det A put them in different
-   aspects: then no non-singular path exists and :class:`NoPathError` says so.
-2. A shortest path (A*, exact for the metric below) in the face-adjacency graph
-   of the paving boxes certified INSIDE the aspect, from the box nearest the
-   start solution to the box nearest the goal.  Edge weight: the distance of the
-   box centres in the metric ``sqrt(dx^2 + dy^2 + (L dphi)^2)``, dphi taken
-   modulo 2 pi and L the root-mean-square distance of the platform points from
-   B1 (so a rotation costs about what it moves the platform).
-3. Waypoints: the start solution, the centre of the face piece shared by each
-   pair of consecutive boxes, the goal solution.  Each straight segment between
-   them lies in one certified box.
-4. Smoothing: a waypoint is dropped when the straight segment that skips it is
-   itself certified (step 5); the farthest certifiable waypoint is searched by
-   doubling then bisection.
+1. Box path.  A* (exact for its metric) in the face-adjacency graph of the
+   paving boxes certified INSIDE the aspect, from the box nearest the start
+   pose to the box nearest the goal.  Edge weight: the distance of the box
+   centres in the metric ``sqrt(dx^2 + dy^2 + (L dphi)^2)``, dphi taken modulo
+   2 pi and L the root-mean-square distance of the platform points from B1
+   (so a rotation costs about what it moves the platform).
+2. Waypoints: the centre of the face piece shared by each pair of
+   consecutive boxes, so that each straight segment between waypoints lies in
+   one certified box.  phi is UNWRAPPED along the path: a box reached across
+   the seam phi = +-pi is shifted by 2 pi, and the goal is met at its phi plus
+   2 pi ``turns``.
+3. Smoothing: a waypoint is dropped when the straight segment that skips it
+   keeps to boxes certified in the aspect (a float look along it) and is
+   itself certified; the farthest such waypoint is found by doubling the jump,
+   then bisecting.
 
-phi convention
---------------
-Waypoints carry an UNWRAPPED phi: phi is continuous along the path, it starts at
-the start solution's phi (in (-pi, pi]) and may leave (-pi, pi] when the path
-crosses the seam phi = +-pi.  The last waypoint is the goal solution's phi plus
-``2 pi * phi_turns``.  Take phi modulo 2 pi to get the usual pose.  The
-kinematics are 2 pi periodic in phi, so nothing else changes.
-
-Certificate (proofs/lemma-trajectory-certificate.md)
-----------------------------------------------------
-The motion is the concatenation of the exact straight segments
-P(t) = A + t (B - A), t in [0, 1], between consecutive waypoints, where the
-first A and the last B are the EXACT solutions (known through their enclosures)
-and the other waypoints are the floats stored.  For each segment, [0, 1] is cut
-into pieces [t0, t1]; the interval expression A + [t0, t1] (B - A) (outward
-rounded, A and B as intervals) is a box containing the piece of the segment,
-and on that box :func:`kinematics.det_a_interval` is proved of the aspect's sign
-and :func:`kinematics.rho_sq_interval` proved within [rho_min^2, rho_max^2] for
-every leg.  Failing pieces are bisected; past :data:`MAX_BISECTIONS` halvings
-the segment is not certified (``certified`` False, with the reason).  This test
-does not use the paving at all: the paving only proposes the path.
-
-Also reported, with what each claim rests on:
-
-* the basic regions crossed (when a :class:`~intervalkin.space.basic_region.RegionAnalysis`
-  is given): region ids of the paving leaves met by points sampled along the
-  path at steps below half the finest leaf width, consecutive repeats merged,
-  -1 ("layer") where the leaf carries no region (the enclosure of S_c or an
-  undecided sheet).  Sampled, so a region touched only between two samples
-  could be missed;
-* the joint-space image (when a :class:`~intervalkin.space.joint_space.JointPaving` is
-  given): each piece of each segment is enclosed in a box, its interval image
-  g(box) computed, and :meth:`JointPaving.cell_of_boxes` names the cell that
-  contains it: a certified statement "this piece maps into cell c", whose count
-  is certified.  Pieces whose image may meet g(S) are reported as "layer".
-  Unlike ``cell_at`` on rounded joint vectors, this covers every point of the path.
-
-In both sequences a layer stretch between two visits of the same region (or
-cell) is merged into it: the path left the certified part and came back, and
-what it met meanwhile is not resolved at this depth.  The raw per-sample region
-ids are kept in ``Trajectory.sample_region``.
+:class:`LeafIndex` finds the leaf holding each point, for the smoothing and for
+the regions crossed by the path.
 """
 
 from __future__ import annotations
@@ -77,28 +31,33 @@ import math
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.interval import PI_HI, PI_LO, Interval
+from intervalkin.core.interval import PI_HI
 from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
+from intervalkin.solve.continuation import _shift_phi
 from intervalkin.space.segment import certify_segment
+
+__all__ = ['metric_length', 'wrap_phi', 'path_distance', 'shortest_box_path', 'crossing_waypoints', 'goal_turns',
+           'shift_phi', 'smooth_waypoints', 'LeafIndex', 'sample_path']
 
 
 # --------------------------------------------------------------------------------------
 # Shortest path in the box graph
 # --------------------------------------------------------------------------------------
-def _metric_length(geometry: Geometry) -> float:
+def metric_length(geometry: Geometry) -> float:
     """L: root-mean-square distance of the three platform points from B1."""
     return math.sqrt(sum(float(geometry.platform_radius_sq(i)) for i in range(3)) / 3.0)
 
 
-def _wrap(d: np.ndarray) -> np.ndarray:
+def wrap_phi(d: np.ndarray) -> np.ndarray:
     """d modulo 2 pi into [-pi, pi)."""
-    return np.mod(d + math.pi, _TWO_PI) - math.pi
+    return np.mod(d + math.pi, math.tau) - math.pi
 
 
-def _dist(a: np.ndarray, b: np.ndarray, L: float) -> np.ndarray:
-    dphi = _wrap(b[..., 2] - a[..., 2])
+def path_distance(a: np.ndarray, b: np.ndarray, L: float) -> np.ndarray:
+    """sqrt(dx^2 + dy^2 + (L dphi)^2) between poses a and b (..., 3), dphi modulo 2 pi."""
+    dphi = wrap_phi(b[..., 2] - a[..., 2])
     return np.sqrt((b[..., 0] - a[..., 0]) ** 2 + (b[..., 1] - a[..., 1]) ** 2 + (L * dphi) ** 2)
 
 
@@ -106,13 +65,13 @@ def _point_box_distance(p: np.ndarray, lo: np.ndarray, hi: np.ndarray, L: float)
     dx = np.maximum(np.maximum(lo[:, 0] - p[0], p[0] - hi[:, 0]), 0.0)
     dy = np.maximum(np.maximum(lo[:, 1] - p[1], p[1] - hi[:, 1]), 0.0)
     best = np.full(lo.shape[0], np.inf)
-    for shift in (-_TWO_PI, 0.0, _TWO_PI):
+    for shift in (-math.tau, 0.0, math.tau):
         ph = p[2] + shift
         best = np.minimum(best, np.maximum(np.maximum(lo[:, 2] - ph, ph - hi[:, 2]), 0.0))
     return np.sqrt(dx * dx + dy * dy + (L * best) ** 2)
 
 
-def _shortest_box_path(paving: Paving, edges: np.ndarray, name: str, start: np.ndarray, goal: np.ndarray,
+def shortest_box_path(paving: Paving, edges: np.ndarray, name: str, start: np.ndarray, goal: np.ndarray,
                        L: float) -> np.ndarray | None:
     """Indices of the boxes of a shortest path (A*), or None when start and goal are not connected."""
     inside = paving.labels[name] == Label.INSIDE
@@ -128,12 +87,12 @@ def _shortest_box_path(paving: Paving, edges: np.ndarray, name: str, start: np.n
     e = edges[:, inside[edges[0]] & inside[edges[1]]]
     u = np.concatenate([local[e[0]], local[e[1]]])
     v = np.concatenate([local[e[1]], local[e[0]]])
-    w = _dist(centre[u], centre[v], L)
+    w = path_distance(centre[u], centre[v], L)
     order = np.argsort(u, kind="stable")
     u, v, w = u[order], v[order], w[order]
     indptr = np.concatenate([[0], np.cumsum(np.bincount(u, minlength=nodes.size))]).tolist()
     nbr, wt = v.tolist(), w.tolist()
-    h = _dist(centre, centre[t], L).tolist()  # consistent heuristic: the same metric
+    h = path_distance(centre, centre[t], L).tolist()  # consistent heuristic: the same metric
     dist = {s: 0.0}
     prev = {s: -1}
     heap = [(h[s], 0.0, s)]
@@ -160,20 +119,20 @@ def _shortest_box_path(paving: Paving, edges: np.ndarray, name: str, start: np.n
     return nodes[np.array(path[::-1], dtype=np.int64)]
 
 
-def _crossing_waypoints(paving: Paving, path: np.ndarray, start_phi: float) -> tuple[np.ndarray, np.ndarray]:
+def crossing_waypoints(paving: Paving, path: np.ndarray, start_phi: float) -> tuple[np.ndarray, np.ndarray]:
     """Centres of the shared face pieces along a box path, phi unwrapped; also each box's phi offset."""
     lo, hi = paving.lo[path], paving.hi[path]
     offs = np.zeros(len(path))
     c0 = 0.5 * (lo[0, 2] + hi[0, 2])
-    offs[0] = _TWO_PI * round((start_phi - c0) / _TWO_PI)
+    offs[0] = math.tau * round((start_phi - c0) / math.tau)
     points = []
     for k in range(len(path) - 1):
         a_lo, a_hi, b_lo, b_hi = lo[k], hi[k], lo[k + 1], hi[k + 1]
         shift = 0.0
         if a_hi[2] == PI_HI and b_lo[2] == -PI_HI and not (b_lo[2] <= a_hi[2] and a_lo[2] <= b_hi[2]):
-            shift = _TWO_PI  # across the seam upward
+            shift = math.tau  # across the seam upward
         elif b_hi[2] == PI_HI and a_lo[2] == -PI_HI and not (b_lo[2] <= a_hi[2] and a_lo[2] <= b_hi[2]):
-            shift = -_TWO_PI
+            shift = -math.tau
         offs[k + 1] = offs[k] + shift
         b_lo_u = b_lo.copy()
         b_hi_u = b_hi.copy()
@@ -188,26 +147,24 @@ def _crossing_waypoints(paving: Paving, path: np.ndarray, start_phi: float) -> t
     return np.array(points).reshape(-1, 3), offs
 
 
-def _goal_turns(goal_phi: float, last_centre_phi: float) -> int:
-    return int(round((last_centre_phi - goal_phi) / _TWO_PI))
+def goal_turns(goal_phi: float, last_centre_phi: float) -> int:
+    """The number of turns k that brings goal_phi + 2 pi k nearest the phi reached by the path."""
+    return int(round((last_centre_phi - goal_phi) / math.tau))
 
 
-def _shift_phi(box: np.ndarray, turns: int) -> np.ndarray:
-    """The enclosure box with phi + 2 pi turns, rounded outward."""
+def shift_phi(box: np.ndarray, turns: int) -> np.ndarray:
+    """The enclosure box (3, 2) with phi + 2 pi turns, rounded outward (the box itself for 0 turns)."""
     if turns == 0:
         return box.copy()
-    two_pi = Interval(np.float64(2.0 * PI_LO), np.float64(2.0 * PI_HI))
-    s = Interval(np.float64(box[2, 0]), np.float64(box[2, 1])) + two_pi * float(turns)
-    out = box.copy()
-    out[2] = [float(s.lo), float(s.hi)]
-    return out
+    lo, hi = _shift_phi(box[None, :, 0], box[None, :, 1], np.array([turns]))
+    return np.stack([lo[0], hi[0]], axis=1)
 
 
 # --------------------------------------------------------------------------------------
 # Smoothing
 # --------------------------------------------------------------------------------------
-def _smooth(geometry: Geometry, ends: list[np.ndarray], sign: int, quick: int,
-            leaves: "_LeafIndex", name: str) -> list[int]:
+def smooth_waypoints(geometry: Geometry, ends: list[np.ndarray], sign: int, quick: int,
+                     leaves: LeafIndex, name: str) -> list[int]:
     """Indices of the waypoints kept: from each kept one, jump to the farthest acceptable one.
 
     A shortcut is acceptable when points sampled along it (steps below half the
@@ -267,9 +224,9 @@ def _smooth(geometry: Geometry, ends: list[np.ndarray], sign: int, quick: int,
 
 
 # --------------------------------------------------------------------------------------
-# Regions and joint cells along the path
+# Points along the path, and the leaves that hold them
 # --------------------------------------------------------------------------------------
-class _LeafIndex:
+class LeafIndex:
     """Finds the leaf of a paving that holds each point (sorted integer keys per level)."""
 
     def __init__(self, paving: Paving):
@@ -292,7 +249,7 @@ class _LeafIndex:
         d = p.depth
         n = 1 << d
         pts = np.array(points, dtype=np.float64, copy=True).reshape(-1, 3)
-        pts[:, 2] = _wrap(pts[:, 2])
+        pts[:, 2] = wrap_phi(pts[:, 2])
         width = p.domain[:, 1] - p.domain[:, 0]
         f = np.floor((pts - p.domain[:, 0]) / (width / n)).astype(np.int64)
         ok = np.all((f >= 0) & (f < n), axis=1)
@@ -307,7 +264,7 @@ class _LeafIndex:
         return out
 
 
-def _samples(waypoints: np.ndarray, step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def sample_path(waypoints: np.ndarray, step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Points along each segment with every coordinate step below ``step``; segment index of each."""
     pts, seg = [], []
     for k in range(len(waypoints) - 1):
@@ -319,14 +276,3 @@ def _samples(waypoints: np.ndarray, step: np.ndarray) -> tuple[np.ndarray, np.nd
         pts.append(a + t[:, None] * (b - a))
         seg.append(np.full(t.size, k))
     return np.concatenate(pts), np.concatenate(seg)
-
-
-def _dedupe(seq) -> list:
-    out: list = []
-    for s in seq:
-        if not out or out[-1] != s:
-            out.append(s)
-    return out
-
-
-_TWO_PI = 2.0 * math.pi

@@ -1,72 +1,21 @@
-"""Certified non-singular trajectories between assembly modes of one aspect.
+"""A straight motion certified to stay in one aspect and in the joint limits.
 
-The paper (section 3.2, Table 1) observes that solutions 2, 3 and 6 of the joint
-vector rho = (14.98, 15.38, 12.0) lie in one aspect WA1, so the platform can move
-from one to another without meeting a type-2 singularity; section 5.2 and
-Figure 13 add that such a motion must pass through an intermediate basic region,
-whose image is a joint-space domain with only two solutions.  This module builds
-such a motion and PROVES it non-singular.
-
-Construction
-------------
-1. The two solutions are the certified direct-kinematic boxes of
-   :func:`dkp.solve` (numbered from 1 in increasing phi, as ``intervalkin dkp``
-   prints them).  Opposite certified signs of det A put them in different
-   aspects: then no non-singular path exists and :class:`NoPathError` says so.
-2. A shortest path (A*, exact for the metric below) in the face-adjacency graph
-   of the paving boxes certified INSIDE the aspect, from the box nearest the
-   start solution to the box nearest the goal.  Edge weight: the distance of the
-   box centres in the metric ``sqrt(dx^2 + dy^2 + (L dphi)^2)``, dphi taken
-   modulo 2 pi and L the root-mean-square distance of the platform points from
-   B1 (so a rotation costs about what it moves the platform).
-3. Waypoints: the start solution, the centre of the face piece shared by each
-   pair of consecutive boxes, the goal solution.  Each straight segment between
-   them lies in one certified box.
-4. Smoothing: a waypoint is dropped when the straight segment that skips it is
-   itself certified (step 5); the farthest certifiable waypoint is searched by
-   doubling then bisection.
-
-phi convention
---------------
-Waypoints carry an UNWRAPPED phi: phi is continuous along the path, it starts at
-the start solution's phi (in (-pi, pi]) and may leave (-pi, pi] when the path
-crosses the seam phi = +-pi.  The last waypoint is the goal solution's phi plus
-``2 pi * phi_turns``.  Take phi modulo 2 pi to get the usual pose.  The
-kinematics are 2 pi periodic in phi, so nothing else changes.
-
-Certificate (proofs/lemma-trajectory-certificate.md)
-----------------------------------------------------
-The motion is the concatenation of the exact straight segments
-P(t) = A + t (B - A), t in [0, 1], between consecutive waypoints, where the
-first A and the last B are the EXACT solutions (known through their enclosures)
-and the other waypoints are the floats stored.  For each segment, [0, 1] is cut
+The motion is P(t) = A + t (B - A), t in [0, 1], where A and B are known
+through enclosures (the exact solutions of the direct kinematics at the ends of
+a trajectory, or float waypoints, whose enclosures are points).  [0, 1] is cut
 into pieces [t0, t1]; the interval expression A + [t0, t1] (B - A) (outward
-rounded, A and B as intervals) is a box containing the piece of the segment,
-and on that box :func:`kinematics.det_a_interval` is proved of the aspect's sign
-and :func:`kinematics.rho_sq_interval` proved within [rho_min^2, rho_max^2] for
-every leg.  Failing pieces are bisected; past :data:`MAX_BISECTIONS` halvings
-the segment is not certified (``certified`` False, with the reason).  This test
-does not use the paving at all: the paving only proposes the path.
+rounded, A and B as intervals) is a box holding the piece of the segment for
+every A and B in their enclosures, and on that box
+:func:`~intervalkin.kinematics.enclosures.det_a_interval` is proved of the
+aspect's sign and :func:`~intervalkin.kinematics.enclosures.rho_sq_interval`
+within [rho_min^2, rho_max^2] for every leg.  A piece that is undecided is
+halved; a piece proved wrong (det A of the other sign, or a leg beyond a limit,
+on the whole piece) ends the attempt with that reason, and so does a piece
+halved :data:`MAX_BISECTIONS` times or more than :data:`MAX_PIECES` pieces
+(proofs/lemma-trajectory-certificate.md).
 
-Also reported, with what each claim rests on:
-
-* the basic regions crossed (when a :class:`~intervalkin.space.basic_region.RegionAnalysis`
-  is given): region ids of the paving leaves met by points sampled along the
-  path at steps below half the finest leaf width, consecutive repeats merged,
-  -1 ("layer") where the leaf carries no region (the enclosure of S_c or an
-  undecided sheet).  Sampled, so a region touched only between two samples
-  could be missed;
-* the joint-space image (when a :class:`~intervalkin.space.joint_space.JointPaving` is
-  given): each piece of each segment is enclosed in a box, its interval image
-  g(box) computed, and :meth:`JointPaving.cell_of_boxes` names the cell that
-  contains it: a certified statement "this piece maps into cell c", whose count
-  is certified.  Pieces whose image may meet g(S) are reported as "layer".
-  Unlike ``cell_at`` on rounded joint vectors, this covers every point of the path.
-
-In both sequences a layer stretch between two visits of the same region (or
-cell) is merged into it: the path left the certified part and came back, and
-what it met meanwhile is not resolved at this depth.  The raw per-sample region
-ids are kept in ``Trajectory.sample_region``.
+A certified segment never meets det A = 0: the platform moves without a type-2
+singularity and without leaving the joint limits.
 """
 
 from __future__ import annotations
@@ -82,7 +31,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_interval
 
-__all__ = ['MAX_BISECTIONS', 'SegmentCertificate', 'certify_segment']
+__all__ = ['MAX_BISECTIONS', 'MAX_PIECES', 'SegmentCertificate', 'piece_boxes', 'certify_segment']
 
 #: A piece of a segment is halved at most this many times (piece length >= 2**-MAX_BISECTIONS).
 MAX_BISECTIONS = 40
@@ -90,9 +39,6 @@ MAX_BISECTIONS = 40
 MAX_PIECES = 1 << 16
 
 
-# --------------------------------------------------------------------------------------
-# The segment certificate
-# --------------------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
 class SegmentCertificate:
     """The straight motion from A to B, and the pieces on which it was proved.
@@ -121,12 +67,12 @@ class SegmentCertificate:
     reason: str = ""
 
     def boxes(self, pieces: np.ndarray | None = None) -> np.ndarray:
-        """Boxes (k, 3, 2) enclosing the pieces of the segment (sound)."""
+        """Boxes (k, 3, 2) enclosing the pieces (all of them, or the (k, 2) ``pieces`` given) of the segment."""
         p = self.pieces if pieces is None else pieces
-        return _piece_boxes(self.start, self.end, p[:, 0], p[:, 1])
+        return piece_boxes(self.start, self.end, p[:, 0], p[:, 1])
 
 
-def _piece_boxes(start: np.ndarray, end: np.ndarray, t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
+def piece_boxes(start: np.ndarray, end: np.ndarray, t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
     """Enclosures of {A + t (B - A) : A in start, B in end, t in [t0, t1]} as (k, 3, 2) boxes.
 
     Written A + T (B - A) with outward-rounded interval operations: the width is
@@ -141,10 +87,14 @@ def _piece_boxes(start: np.ndarray, end: np.ndarray, t0: np.ndarray, t1: np.ndar
     return np.stack([lo, hi], axis=-1)
 
 
-def _limit_bounds(geometry: Geometry) -> tuple[np.ndarray, np.ndarray]:
-    """Floats: an upper bound of each rho_min^2 and a lower bound of each rho_max^2."""
-    lo = np.array([fraction_bounds(Fraction(v) ** 2)[1] for v in geometry.rho_min])
-    hi = np.array([fraction_bounds(Fraction(v) ** 2)[0] for v in geometry.rho_max])
+def _limit_bounds(geometry: Geometry, inner: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Float bounds of each rho_min^2 and rho_max^2, rounded inward (``inner``) or outward.
+
+    Inner bounds (an upper bound of rho_min^2, a lower bound of rho_max^2) prove a
+    leg within its limits; outer bounds prove it beyond them.
+    """
+    lo = np.array([fraction_bounds(Fraction(v) ** 2)[1 if inner else 0] for v in geometry.rho_min])
+    hi = np.array([fraction_bounds(Fraction(v) ** 2)[0 if inner else 1] for v in geometry.rho_max])
     return lo, hi
 
 
@@ -152,9 +102,9 @@ def _boxes_certified(geometry: Geometry, boxes: np.ndarray, sign: int) -> np.nda
     """(k,) bool: det A proved of sign ``sign`` and every leg proved within its limits on each box."""
     d = det_a_interval(geometry, boxes)
     ok = (d.lo > 0) if sign > 0 else (d.hi < 0)
-    lo_sq, hi_sq = _limit_bounds(geometry)
-    for i, r in enumerate(rho_sq_interval(geometry, boxes)):
-        ok &= (r.lo >= lo_sq[i]) & (r.hi <= hi_sq[i])
+    lo_sq, hi_sq = _limit_bounds(geometry, inner=True)
+    r = rho_sq_interval(geometry, boxes)
+    ok &= np.all((r.lo >= lo_sq) & (r.hi <= hi_sq), axis=1)
     return np.asarray(ok, dtype=bool)
 
 
@@ -162,10 +112,9 @@ def _boxes_refuted(geometry: Geometry, boxes: np.ndarray, sign: int) -> np.ndarr
     """(k,) bool: det A proved of the WRONG sign, or some leg proved beyond a limit, on the whole box."""
     d = det_a_interval(geometry, boxes)
     bad = (d.hi < 0) if sign > 0 else (d.lo > 0)
-    lo_sq = np.array([fraction_bounds(Fraction(v) ** 2)[0] for v in geometry.rho_min])
-    hi_sq = np.array([fraction_bounds(Fraction(v) ** 2)[1] for v in geometry.rho_max])
-    for i, r in enumerate(rho_sq_interval(geometry, boxes)):
-        bad |= (r.hi < lo_sq[i]) | (r.lo > hi_sq[i])
+    lo_sq, hi_sq = _limit_bounds(geometry, inner=False)
+    r = rho_sq_interval(geometry, boxes)
+    bad |= np.any((r.hi < lo_sq) | (r.lo > hi_sq), axis=1)
     return np.asarray(bad, dtype=bool)
 
 
@@ -212,13 +161,13 @@ def certify_segment(
     done: list[np.ndarray] = []
     total = 0
     while t0.size:
-        ok = _boxes_certified(geometry, _piece_boxes(a, b, t0, t1), sign)
+        ok = _boxes_certified(geometry, piece_boxes(a, b, t0, t1), sign)
         done.append(np.stack([t0[ok], t1[ok]], axis=1))
         bad = ~ok
         if not np.any(bad):
             break
         t0, t1, level = t0[bad], t1[bad], level[bad]
-        refuted = _boxes_refuted(geometry, _piece_boxes(a, b, t0, t1), sign)
+        refuted = _boxes_refuted(geometry, piece_boxes(a, b, t0, t1), sign)
         if np.any(refuted):
             k = int(np.argmax(refuted))
             why = (f"the motion leaves the aspect or the joint limits: on t in [{t0[k]:.17g}, {t1[k]:.17g}] "

@@ -1,45 +1,23 @@
-"""Certified continuation of direct-kinematic solutions along joint-space paths.
+"""Sheets above a joint cell: which certified solution each piece of a workspace paving continues.
 
-Used by :mod:`intervalkin.space.basic_region` to tell which sheet above a joint cell a piece
-of certified boxes lies in (proofs/lemma-sheet-continuation.md).
+Above a joint cell C (certified off g(S)), the poses of one aspect with g(X) in C
+form k sheets, each mapped one-to-one onto C by g: every q of C has one solution
+on each sheet (proofs/lemma-theorem1-distinctness.md (d)).  Basic regions are
+built from the pieces of the paving certified off S_c; two pieces above C lie
+in the same basic region exactly when they lie on the same sheet.  Sheet s of an
+aspect is named by the s-th certified solution of a reference joint vector
+root_q of the cell.
 
-Parameter Krawczyk test
------------------------
-Along a segment q(t) = q_a + t (q_b - q_a) of joint space (q_a, q_b exact, t a
-float) the system is F(X, t)_i = |B_i(X) - A_i|^2 - rho_i(t)^2.  For a box X,
-a parameter interval T = [t0, t1], a point m of X, a float matrix Y (inverse of
-the float Jacobian at m) and an interval matrix J(X) enclosing dF/dX over X
-(independent of t),
-
-    K(X, T) = m - Y F(m, tm) - (T - tm) Y dF/dt(m, T) + (I - Y J(X)) (X - m)
-
-encloses m - Y F(m, t) + (I - Y J(X)) (X - m) for every t in T (mean value in t,
-dF_i/dt = -2 rho_i(t) (q_b - q_a)_i).  If K(X, T) lies in the interior of X,
-then for EVERY t in T the box X holds exactly one solution x(t), every Jacobian
-on X is non-singular (so det A keeps one sign on X) and t -> x(t) is continuous
-(proofs/lemma-krawczyk-uniqueness.md applied at each t; closed graph in a
-compact box).  Every zero of F(., t1) in X also lies in
-
-    K1 = p - Y F(p, t1) + (I - Y J(X)) (X - p)     (any point p of X),
-
-so K1 n X is a box that holds the solution at t1 (no interior test needed).
-All of it is evaluated with :class:`intervalkin.core.interval.Interval` (outward
-rounding), vectorized over many tracks at once.
-
-Tracking
---------
-A track carries a box Z known to hold the followed solution at q(t).  A step
-[t, t1] predicts the solution at t1 in float (tangent + Newton), builds X around
-both ends and around Z, and accepts the step when K(X, [t, t1]) is inside X:
-the followed solution is then the unique one in X for all of [t, t1], and
-Z := K1 n X at t1.  The step doubles on success and halves on failure, with a
-floor below which the track gives up (never a guess).
-
-Voxel paths
------------
-Paths run inside one joint cell: between centres of face-adjacent voxels of the
-cell (the segment lies in the union of the two closed voxels), in straight runs
-along a breadth-first tree of the cell rooted at the cell's witness voxel.
+:func:`identify_sheets` names the sheet of a piece by certified continuation
+(proofs/lemma-sheet-continuation.md): a certified solution inside the piece is
+followed (parameter Krawczyk, :mod:`intervalkin.solve.continuation`) along
+straight joint-space segments inside C (:mod:`intervalkin.space.voxel_paths`)
+to a voxel centre, where it is matched against the reference solutions carried
+there along the same kind of paths.  Each step of a track is proved (one
+solution in the track's box for the whole parameter range), so a match is a
+proof that the piece and the reference solution lie on one sheet.  A piece
+whose track fails, or whose match is ambiguous, stays undecided (-1): it is
+never named by a guess.
 """
 
 from __future__ import annotations
@@ -49,11 +27,9 @@ from fractions import Fraction
 
 import numpy as np
 
-from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
-from intervalkin.kinematics.constants import _k
-from intervalkin.kinematics.formulas import _approx_f_and_jacobian
+from intervalkin.kinematics.formulas import approx_inverse_kinematics
 from intervalkin.solve.continuation import (
     Tracks,
     certify_start,
@@ -62,121 +38,25 @@ from intervalkin.solve.continuation import (
     step_tracks,
 )
 from intervalkin.solve.dkp import solve
+from intervalkin.space.voxel_paths import (
+    straight_edges,
+    voxel_centres,
+    voxel_of_points,
+    voxel_tree,
+)
+
+__all__ = ['SheetReport', 'identify_sheets']
 
 
-# --------------------------------------------------------------------------------------
-# Voxel tree of one joint cell
-# --------------------------------------------------------------------------------------
-def voxel_tree(in_cell: np.ndarray, root: tuple[int, int, int]):
-    """Breadth-first tree of the True voxels of a 3-D grid, from ``root``.
-
-    Returns (parent, direction) as flat arrays over the grid (-1 outside the
-    tree).  ``direction`` d in 0..5 says the voxel is its parent moved one step
-    along axis d // 2, in the + sense when d is even.  Among the parents at the
-    previous distance, one reached along the parent's own direction is preferred,
-    so that the tree paths run in long straight runs.
-    """
-    shape = in_cell.shape
-    free = in_cell.ravel()
-    n = free.size
-    strides = np.array([shape[1] * shape[2], shape[2], 1], dtype=np.int64)
-    parent = np.full(n, -1, dtype=np.int64)
-    direction = np.full(n, -1, dtype=np.int8)
-    seen = np.zeros(n, dtype=bool)
-    r = int(np.dot(root, strides))
-    if not free[r]:
-        raise ValueError("root voxel is not in the cell")
-    seen[r] = True
-    front = np.array([r], dtype=np.int64)
-    while front.size:
-        coords = np.stack(np.unravel_index(front, shape), axis=1)
-        cand_v, cand_u, cand_d, cand_pref = [], [], [], []
-        for d in range(6):
-            axis, sgn = d // 2, (1 if d % 2 == 0 else -1)
-            c = coords[:, axis] + sgn
-            okc = (c >= 0) & (c < shape[axis])
-            u = front[okc]
-            v = u + sgn * strides[axis]
-            keep = free[v] & ~seen[v]
-            u, v = u[keep], v[keep]
-            cand_v.append(v)
-            cand_u.append(u)
-            cand_d.append(np.full(v.size, d, dtype=np.int8))
-            cand_pref.append((direction[u] != d).astype(np.int8))  # 0 = same direction as the parent link
-        v = np.concatenate(cand_v)
-        if v.size == 0:
-            break
-        u = np.concatenate(cand_u)
-        dd = np.concatenate(cand_d)
-        pref = np.concatenate(cand_pref)
-        order = np.lexsort((dd, pref, v))
-        v, u, dd = v[order], u[order], dd[order]
-        first = np.ones(v.size, dtype=bool)
-        first[1:] = v[1:] != v[:-1]
-        v, u, dd = v[first], u[first], dd[first]
-        parent[v] = u
-        direction[v] = dd
-        seen[v] = True
-        front = v
-    return parent, direction
-
-
-def straight_edges(parent: np.ndarray, direction: np.ndarray, root: int, targets, max_run: int = 1 << 30):
-    """Edges (top, bottom, length) of the tree spanned by root and targets, cut into straight runs.
-
-    Each edge joins two voxels of one straight run of the tree, at most
-    ``max_run`` voxels apart; every voxel in between is a tree voxel, so the
-    segment between their centres lies in the union of the closed voxels of
-    the run.  Edges are listed top-down: an edge's top is the root or the
-    bottom of an earlier edge.
-    """
-    children: dict[int, list[int]] = {}
-    in_union = {root}
-    for t in targets:
-        v = int(t)
-        while v not in in_union:
-            in_union.add(v)
-            u = int(parent[v])
-            if u < 0:
-                raise ValueError("target voxel not in the tree")
-            children.setdefault(u, []).append(v)
-            v = u
-    target_set = {int(t) for t in targets}
-    edges: list[tuple[int, int, int]] = []
-    stack = [(root, c) for c in children.get(root, [])]
-    while stack:
-        top, v = stack.pop()
-        run = 1
-        while run < max_run:  # walk down the straight run while the node is not a stop
-            ch = children.get(v, [])
-            if v in target_set or len(ch) != 1 or direction[ch[0]] != direction[v]:
-                break
-            v = ch[0]
-            run += 1
-        edges.append((top, v, run))
-        stack.extend((v, c) for c in children.get(v, []))
-    return edges
-
-
-def voxel_centres(joint, flat: np.ndarray) -> Interval:
-    """Enclosures (m, 3) of the exact centres rho_min + (k + 1/2) step of voxels (flat C order)."""
-    idx = np.stack(np.unravel_index(np.asarray(flat, dtype=np.int64), (joint.n,) * 3), axis=1).astype(np.float64)
-    r0 = [fraction_bounds(v) for v in joint.rho_min]
-    h = [fraction_bounds(v) for v in joint.step]
-    R0 = Interval(np.array([b[0] for b in r0]), np.array([b[1] for b in r0]))
-    H = Interval(np.array([b[0] for b in h]), np.array([b[1] for b in h]))
-    return R0 + H * (idx + 0.5)
-
-
-# --------------------------------------------------------------------------------------
-# Sheets above one joint cell
-# --------------------------------------------------------------------------------------
-def _take(tr: Tracks, idx: np.ndarray) -> Tracks:
+def _take_tracks(tr: Tracks, idx: np.ndarray) -> Tracks:
+    """The tracks ``idx`` of a batch, as a new batch."""
     return Tracks(tr.qa[idx], tr.qb[idx], tr.t[idx], tr.h[idx], tr.p[idx], tr.z_lo[idx], tr.z_hi[idx],
                   tr.x_lo[idx], tr.x_hi[idx], tr.status[idx], tr.steps[idx])
 
 
-def _concat(parts: list[Tracks]) -> Tracks:
+def _concat_tracks(parts: list[Tracks]) -> Tracks:
+    """One batch holding the tracks of ``parts`` in order."""
+
     def iv(name):
         return Interval(np.concatenate([getattr(p, name).lo for p in parts]),
                         np.concatenate([getattr(p, name).hi for p in parts]))
@@ -186,31 +66,6 @@ def _concat(parts: list[Tracks]) -> Tracks:
 
     return Tracks(iv("qa"), iv("qb"), cat("t"), cat("h"), cat("p"), cat("z_lo"), cat("z_hi"), cat("x_lo"), cat("x_hi"),
                   cat("status"), cat("steps"))
-
-
-def _voxel_of_points(joint, q: np.ndarray) -> np.ndarray:
-    """Voxel index (m, 3) of float joint vectors q (m, 3), checked exactly; -1 rows when outside."""
-    from fractions import Fraction
-
-    r0 = np.array([float(v) for v in joint.rho_min])
-    h = np.array([float(v) for v in joint.step])
-    k = np.floor((q - r0) / h).astype(np.int64)
-    out = np.full(q.shape, -1, dtype=np.int64)
-    for i in range(len(q)):
-        row = []
-        for j in range(3):
-            v = Fraction(float(q[i, j]))
-            kk = int(k[i, j])
-            for cand in (kk, kk - 1, kk + 1):  # the float floor may be one off; the exact test decides
-                if 0 <= cand < joint.n and joint.rho_min[j] + cand * joint.step[j] <= v <= joint.rho_min[j] + (cand + 1) * joint.step[j]:
-                    row.append(cand)
-                    break
-            else:
-                row = None
-                break
-        if row is not None:
-            out[i] = row
-    return out
 
 
 @dataclass
@@ -268,7 +123,7 @@ def identify_sheets(geometry: Geometry, joint, cid: int, root_q, references: dic
     sign_of = {"WA1": 1, "WA2": -1}
     labels = [(a, s_) for a in sorted(references) for s_ in range(len(references[a]))]
     root_idx = tuple(int((root_q[i] - joint.rho_min[i]) / joint.step[i] - Fraction(1, 2)) for i in range(3))
-    if not all(joint.rho_min[i] + (root_idx[i] + Fraction(1, 2)) * joint.step[i] == root_q[i] for i in range(3)):
+    if joint.voxel_centre(root_idx) != tuple(root_q):
         rep.start_failed = m  # the reference must be a voxel centre: nothing is decided
         return sheet, rep
     root = int((root_idx[0] * n + root_idx[1]) * n + root_idx[2])
@@ -276,10 +131,10 @@ def identify_sheets(geometry: Geometry, joint, cid: int, root_q, references: dic
     # 1. a certified solution inside each start box, and its voxel
     lo_b, hi_b = start_boxes[:, :, 0], start_boxes[:, :, 1]
     x_r = 0.5 * (lo_b + hi_b)
-    q_r = np.sqrt(_approx_f_and_jacobian(_k(geometry), x_r)[0])
+    q_r = approx_inverse_kinematics(geometry, x_r)
     ok, zl, zh, p = certify_start(geometry, Interval.point(q_r), x_r)
     ok &= np.all((lo_b <= zl) & (zh <= hi_b), axis=1)
-    vox = _voxel_of_points(joint, q_r)
+    vox = voxel_of_points(joint, q_r)
     ok &= np.all(vox >= 0, axis=1)
     flat = np.where(ok, (vox[:, 0] * n + vox[:, 1]) * n + vox[:, 2], 0)
     ok &= joint.cell.ravel()[flat] == cid
@@ -304,7 +159,7 @@ def identify_sheets(geometry: Geometry, joint, cid: int, root_q, references: dic
         owner[bot] = owner[top]
         since[bot] = d
         if d >= hub_spacing:
-            q = _voxel_centre_exact(joint, bot)
+            q = joint.voxel_centre(np.unravel_index(bot, (n,) * 3))
             boxes = _hub_solutions(geometry, q, references, sign_of)
             if boxes is not None:
                 hub_parent[bot] = owner[top]
@@ -344,7 +199,7 @@ def identify_sheets(geometry: Geometry, joint, cid: int, root_q, references: dic
     if first:
         pool.append(edge_tracks(first))
         meta += [("edge", e, h, li) for e, h, li in first]
-    active = _concat(pool)
+    active = _concat_tracks(pool)
     final: dict[int, tuple[np.ndarray, np.ndarray]] = {}
     while meta:
         step_tracks(geometry, active, np.flatnonzero(active.status == 0))
@@ -371,12 +226,12 @@ def identify_sheets(geometry: Geometry, joint, cid: int, root_q, references: dic
                 atlas[(bot, h, li)] = (active.z_lo[i].copy(), active.z_hi[i].copy())
                 spawn += [(e, h, li) for e in below.get(bot, [])]
         keep = np.flatnonzero(active.status == 0)
-        parts = [_take(active, keep)]
+        parts = [_take_tracks(active, keep)]
         meta = [meta[i] for i in keep]
         if spawn:
             parts.append(edge_tracks(spawn))
             meta += [("edge", e, h, li) for e, h, li in spawn]
-        active = _concat(parts)
+        active = _concat_tracks(parts)
 
     # 4. sheet names at the hubs, top-down: name[h][li] = sheet of the hub's solution li.
     # A hub's solution li is matched to the track (from the hub above) whose final box holds it.
@@ -435,11 +290,6 @@ def _holds(xs: list, zs: list):
         return np.zeros(0, dtype=bool), np.zeros(0, dtype=bool)
     return compare_mod_2pi(np.array([x[0] for x in xs]), np.array([x[1] for x in xs]),
                            np.array([z[0] for z in zs]), np.array([z[1] for z in zs]))
-
-
-def _voxel_centre_exact(joint, flat: int) -> tuple:
-    idx = np.unravel_index(flat, (joint.n,) * 3)
-    return tuple(joint.rho_min[i] + (int(idx[i]) + Fraction(1, 2)) * joint.step[i] for i in range(3))
 
 
 def _hub_solutions(geometry: Geometry, q, references: dict, sign_of: dict):

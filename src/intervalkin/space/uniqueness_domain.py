@@ -1,54 +1,30 @@
-"""Characteristic surfaces, basic regions, basic components and uniqueness domains.
+"""Uniqueness domains: the fewest unions of basic regions on which the direct kinematics is unique.
 
-The paper's sections 4 and 5 (Definitions 2-4, Proposition 1, Theorems 1-2),
-rebuilt on certified pavings.
+Theorem 2 of the paper: a union of basic regions of one aspect whose basic
+components are pairwise disjoint, connected through the characteristic surfaces
+between them, is a domain on which every joint vector has at most one
+solution.  Here the regions of each aspect are partitioned into the fewest
+groups that are connected in the region adjacency graph and hold at most one
+region above each joint cell (regions above one cell have coincident basic
+components).
 
-* Characteristic surface S_c(WA) = {X in WA : g(X) in g(S)} (the joint-limit part
-  of the aspect's boundary maps onto the boundary of the joint box).  A box of an
-  aspect is *certified off S_c* when its interval image g(b) meets no marked
-  voxel of the joint-space enclosure of g(S) (:mod:`intervalkin.space.joint_space`); the
-  boxes of the aspect that are not so certified form an outer enclosure of S_c.
-* Basic regions (Definition 3): connected components of WA minus S_c.  Here:
-  face-connected components (phi seam included) of the boxes certified inside an
-  aspect and off S_c.  Each is connected (union of adjacent closed boxes) and
-  lies in ONE true basic region (it is connected and avoids S_c).
-* Basic component (Definition 4): g of a basic region.  Every box of a region
-  maps into unmarked voxels of one joint cell (its index range is a block of
-  unmarked voxels); adjacent boxes share a face, so a whole region maps into
-  one cell, which the code checks.
-* Sheets: above a cell C with k solutions of an aspect there are exactly k
-  sheets (the basic regions over C); the k solutions of the cell's witness name
-  them, and the sheet of each piece is found by certified continuation inside C
-  (:mod:`intervalkin.solve.continuation`, proofs/lemma-sheet-continuation.md).
-* Distinctness (DESIGN.md section 6): two regions are certified different when
-  (a) their aspects differ (opposite certified det A signs); (b) their cells have
-  different certified counts (different basic components); or (c) a joint
-  vector q has two certified solutions of the same aspect, one in a box of each
-  region: by Theorem 1, g is injective on a basic region, so the two regions lie
-  in different basic regions.  The certified lower bound on the number of basic
-  regions is the size of a largest set of pairwise certified-distinct regions.
-* Proposition 1 check: above each cell C and for each aspect, the number of
-  regions found should equal the certified number of solutions of that aspect
-  in C; every mismatch is reported (a region split by the undecided layer, or
-  one not resolved at this depth).
-* Uniqueness domains (Theorem 2): each aspect's regions are partitioned into the
-  fewest groups that are connected in the region adjacency graph and hold at
-  most one region above each cell.  The number is minimal because the regions
-  above one cell must all be in different groups: it cannot be smaller than the
-  largest number of solutions of one aspect over the cells.
+What is certified: the lower bound.  The certified solutions of one joint
+vector in one aspect lie in pairwise different uniqueness domains, so there are
+at least as many domains of an aspect as the largest number of regions of that
+aspect above one cell; a partition reaching that number is minimal.
 
-What is not certified, and said so in the results: that two cells of equal
-count are different true cells (so regions above them may be parts of one true
-basic region), hence the found number of regions is exact only when the
-consistency checks pass AND the lower bound equals it; and the adjacency of
-regions across the undecided layer (a heuristic: the layer is split between
-the regions by nearest-region growth).
+What is not: the adjacency of regions across the characteristic surfaces.  The
+boxes of an aspect that carry no region (the enclosure of S_c, and pieces whose
+sheet is undecided) are shared out to the nearest region by growth through
+face adjacency, and two regions whose shares touch are called adjacent: a
+heuristic, said so in the counts.
 """
 
 from __future__ import annotations
 
 import time
 
+import networkx as nx
 import numpy as np
 
 from intervalkin.paving.adjacency import grow_labels
@@ -59,9 +35,6 @@ from intervalkin.space.aspect import ASPECTS
 __all__ = ['region_adjacency', 'uniqueness_domains']
 
 
-# --------------------------------------------------------------------------------------
-# Region adjacency across the characteristic surfaces, uniqueness domains
-# --------------------------------------------------------------------------------------
 def region_adjacency(paving: Paving, edges: np.ndarray, region: np.ndarray) -> set[tuple[int, int]]:
     """Pairs of basic regions of one aspect adjacent across its characteristic surface.
 
@@ -92,8 +65,6 @@ def uniqueness_domains(regions, adjacency: set[tuple[int, int]], time_limit: flo
     (those must all be in different groups).  Backtracking from that bound
     upward; the first feasible number of groups is the minimum for this graph.
     """
-    import networkx as nx
-
     g = nx.Graph()
     g.add_nodes_from(r.id for r in regions)
     g.add_edges_from(adjacency)

@@ -1,0 +1,113 @@
+"""The reduced equation of the direct kinematics as a function of the joint vector.
+
+For fixed leg lengths, eliminating the position of B1 (two linear equations, then
+the circle of leg 1; :mod:`intervalkin.kinematics.sextic`) leaves one equation in
+the orientation alone,
+
+    f(phi; r) = |N(phi; r)|^2 - r_1 D(phi)^2 = 0,        r_i = rho_i^2,
+
+a real trigonometric polynomial of degree 3 in phi.  N is affine in r and D does
+not depend on r, so every Fourier coefficient of f is a polynomial of degree at
+most 2 in r = (r_1, r_2, r_3):
+
+    f(phi; r) = sum_h  c_h(r) * basis_h(phi),
+    basis = (1, cos phi, sin phi, cos 2 phi, sin 2 phi, cos 3 phi, sin 3 phi),
+    c_h(r) = sum_m  C[h, m] * monomial_m(r),
+    monomials = (1, r1, r2, r3, r1^2, r1 r2, r1 r3, r2^2, r2 r3, r3^2).
+
+The 7 x 10 matrix C is computed once per geometry, in arb from the exact
+geometry, by polarisation: f is evaluated (with the same Laurent-polynomial
+reduction the certified solver uses) at r = 0, +-e_i and e_i + e_j, which
+determine a quadratic exactly.  Each entry is then enclosed by two floats.
+
+What is certified: ``reduced_coefficients(geometry)`` returns float intervals
+that contain the exact entries of C.  The polarisation identity is exact for a
+polynomial of degree 2, and :func:`tests.kinematics` compares the form with the
+direct reduction at random r in arb.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+from flint import arb, ctx
+
+from intervalkin.core.exact import arb_to_bounds
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import Interval
+from intervalkin.kinematics.sextic import _reduce
+
+__all__ = ["MONOMIALS", "HARMONICS", "ReducedEquation", "reduced_equation"]
+
+#: Exponent pairs of the monomials in r (() is the constant, (i,) is r_i, (i, j) is r_i r_j).
+MONOMIALS: tuple[tuple[int, ...], ...] = ((), (0,), (1,), (2,), (0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+#: (order k, 0 for cos / 1 for sin) of each basis function; (0, 0) is the constant.
+HARMONICS: tuple[tuple[int, int], ...] = ((0, 0), (1, 0), (1, 1), (2, 0), (2, 1), (3, 0), (3, 1))
+
+_PRECISION = 256
+
+
+@dataclass(frozen=True, eq=False)
+class ReducedEquation:
+    """f(phi; r) = sum_h c_h(r) basis_h(phi), c_h quadratic in r = rho^2.
+
+    Attributes
+    ----------
+    coefficients : Interval of shape (7, 10), enclosures of C[h, m] (harmonic h of
+        :data:`HARMONICS`, monomial m of :data:`MONOMIALS`).
+    """
+
+    coefficients: Interval
+
+    @property
+    def midpoint(self) -> np.ndarray:
+        """Float values of C (7, 10), for predictors only."""
+        return self.coefficients.mid()
+
+
+def _fourier(f: dict) -> list:
+    """Real Fourier coefficients (a0, a1, b1, a2, b2, a3, b3) of a real Laurent polynomial in exp(i phi).
+
+    f_k e^{ik phi} + f_{-k} e^{-ik phi} = 2 Re(f_k) cos k phi - 2 Im(f_k) sin k phi when f_{-k} = conj(f_k).
+    """
+    out = [f[0].real]
+    for k in (1, 2, 3):
+        c = f.get(k)
+        out += [2 * c.real, -2 * c.imag] if c is not None else [arb(0), arb(0)]
+    return out
+
+
+@functools.lru_cache(maxsize=32)
+def reduced_equation(geometry: Geometry) -> ReducedEquation:
+    """The coefficient matrix C of f(phi; r) for ``geometry``, enclosed in float intervals."""
+    with ctx.workprec(_PRECISION):
+        cache: dict[tuple[int, int, int], list] = {}
+
+        def at(r: tuple[int, int, int]) -> list:
+            if r not in cache:
+                cache[r] = _fourier(_reduce(geometry, [arb(v) for v in r]).f)
+            return cache[r]
+
+        unit = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
+        f0 = at((0, 0, 0))
+        plus = [at(e) for e in unit]
+        minus = [at(tuple(-v for v in e)) for e in unit]
+        linear = [[(p - m) / 2 for p, m in zip(plus[i], minus[i])] for i in range(3)]
+        square = [[(p + m) / 2 - c for p, m, c in zip(plus[i], minus[i], f0)] for i in range(3)]
+        columns = [f0, *linear]
+        for i, j in MONOMIALS[4:]:
+            if i == j:
+                columns.append(square[i])
+            else:
+                both = at(tuple(a + b for a, b in zip(unit[i], unit[j])))
+                # f(e_i + e_j) = f0 + L_i + L_j + S_i + S_j + (coefficient of r_i r_j)
+                columns.append([b - c - li - lj - si - sj for b, c, li, lj, si, sj in
+                                zip(both, f0, linear[i], linear[j], square[i], square[j])])
+        lo = np.empty((7, 10))
+        hi = np.empty((7, 10))
+        for m, col in enumerate(columns):
+            for h, value in enumerate(col):
+                lo[h, m], hi[h, m] = arb_to_bounds(value)
+    return ReducedEquation(Interval(lo, hi))

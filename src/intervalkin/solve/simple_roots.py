@@ -1,0 +1,199 @@
+"""Joint-space boxes on which the direct kinematics keeps one structure.
+
+The claim
+---------
+For a box R of joint vectors (rho_1, rho_2, rho_3), write r = rho^2 and let
+f(phi; r) be the reduced equation (:mod:`intervalkin.kinematics.reduced_equation`).
+R is *clear* when no (phi, r) with r in R^2 := {rho^2 : rho in R} has
+
+    f(phi; r) = 0   and   df/dphi(phi; r) = 0,
+
+that is, when every real root of f(.; r) is simple, for every r in R.  Then
+(proofs/lemma-simple-roots-constant-count.md):
+
+* the roots of f(.; r) move continuously with r and none appears, disappears or
+  merges, so their number is the same at every point of R (R is connected);
+* a root phi* with D(phi*) = 0 (the 2x2 position system singular) is always a
+  multiple root of f, so every root of a clear box has D != 0 and carries exactly
+  one solution z = N / D: the number of direct-kinematic solutions is constant on R;
+* a solution with det A = 0 is a multiple root of f (on D != 0, f = D^2 g with
+  g(phi) = |z(phi)|^2 - r_1, and det A is proportional to D g'), so every
+  solution stays non-singular on R and keeps its sign of det A: the split of the
+  solutions between the aspects is constant on R too.
+
+So a clear box lies off g(S), and one certified solve at any point of it gives
+its count and aspect split.
+
+The test
+--------
+The circle of orientations is covered by pieces Phi (a piece covering phi = +-pi
+included).  On a piece, the pair (R, Phi) is settled when 0 is excluded from an
+enclosure of f over R x Phi (no root there), or from an enclosure of df/dphi
+(f is strictly monotone in phi on Phi for every r: its roots there are simple).
+Unsettled pieces are bisected, a bounded number of times; a box with an
+unsettled piece at the end is undecided (it may meet g(S)).
+
+Enclosures are mean-value forms about the centre (r_c, phi_m) of R^2 x Phi,
+
+    f(R, Phi) in f(r_c, phi_m) + sum_i d_i f(R, Phi) (R_i - r_c,i) + d_phi f(R, Phi) (Phi - phi_m),
+
+with the gradient enclosed over the whole box (c_h(R), its r-derivatives and the
+phi-derivatives of the basis), all in outward-rounded interval arithmetic
+(:class:`intervalkin.core.interval.Interval`).  The same form with f replaced by
+df/dphi encloses the slope.  Work is vectorised over all (box, piece) pairs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from intervalkin.core.ball import Ball, cos_sin_multiple
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import PI_HI, Interval
+from intervalkin.kinematics.reduced_equation import HARMONICS, MONOMIALS, reduced_equation
+
+__all__ = ["clear_boxes", "PIECES", "HALVINGS"]
+
+#: Pieces of the orientation circle tried first on every box.
+PIECES = 24
+#: Bisections of an unsettled piece before the box is called undecided.
+HALVINGS = 7
+#: A box with more unsettled pieces than this at some round is undecided at once (it straddles g(S)).
+_CROWD = 24
+
+
+def _basis(phi: Ball, deriv: int) -> Ball:
+    """(m, 7) balls of the deriv-th phi-derivative of the basis (1, cos phi, sin phi, ...) over phi (m,)."""
+    mids, rads = [], []
+    for k, is_sin in HARMONICS:
+        if k == 0:
+            mids.append(np.full(phi.mid.shape, 1.0 if deriv == 0 else 0.0))
+            rads.append(np.zeros(phi.mid.shape))
+            continue
+        if is_sin:
+            continue
+        c, s = cos_sin_multiple(phi, k, deriv)
+        mids += [c.mid, s.mid]
+        rads += [c.rad, s.rad]
+    return Ball(np.stack(mids, axis=-1), np.stack(rads, axis=-1))
+
+
+class _Boxes:
+    """Per-box data of the Taylor form in r (computed once, gathered per piece).
+
+    For fixed phi, f(phi; r) = sum_h c_h(r) basis_h(phi) with c_h quadratic in r,
+    so for r = r_c + d, exactly,
+
+        f = c(r_c) . w + sum_i (d c / d r_i)(r_c) . w  d_i + sum_h w_h Q_h(d),
+
+    w = basis(phi) and Q_h the quadratic part of c_h.  Over a piece Phi, w is a
+    ball; |d_i| <= h_i (the half-width of R_i^2) and |w_h| <= k_h^j for the j-th
+    phi-derivative bound the last sum once per box.
+    """
+
+    def __init__(self, geometry: Geometry, boxes: np.ndarray):
+        C = Ball.from_interval(reduced_equation(geometry).coefficients)  # (7, 10)
+        r = [Ball.from_interval(Interval(boxes[:, i, 0], boxes[:, i, 1]).sqr()) for i in range(3)]
+        rc = [Ball.point(ri.mid) for ri in r]
+        self.half = np.stack([ri.rad for ri in r], axis=1)  # (n, 3)
+        n = len(boxes)
+        ones, zeros = Ball.point(np.ones(n)), Ball.point(np.zeros(n))
+        rows: list[list[Ball]] = [[], [], [], []]  # monomials at r_c, then their r_i-derivatives
+        for e in MONOMIALS:
+            rows[0].append(ones if not e else rc[e[0]] if len(e) == 1 else rc[e[0]] * rc[e[1]])
+            for i in range(3):
+                if i not in e:
+                    rows[1 + i].append(zeros)
+                elif len(e) == 1:
+                    rows[1 + i].append(ones)
+                elif e[0] == e[1]:
+                    rows[1 + i].append(rc[i].scale(2.0))
+                else:
+                    rows[1 + i].append(rc[e[1] if e[0] == i else e[0]])
+        monos = _stack([_stack(row) for row in rows], axis=1)  # (n, 4, 10)
+        Ct = Ball(C.mid.T.copy(), C.rad.T.copy())  # (10, 7)
+        self.taylor = monos.matmul(Ct)  # (n, 4, 7): c(r_c) and its three r-derivatives
+        # second-order part: |sum_h w_h Q_h(d)| <= sum_m (sum_h k_h^j |C_hm|) |d-monomial_m|
+        h = self.half
+        dmono = np.zeros((n, 10))
+        for m, e in enumerate(MONOMIALS):
+            if len(e) == 2:
+                dmono[:, m] = h[:, e[0]] * h[:, e[1]]
+        orders = np.array([k for k, _ in HARMONICS], dtype=np.float64)
+        absC = np.abs(C.mid) + C.rad
+        self.second = [(dmono @ ((orders[:, None] ** j) * absC).T).sum(axis=1) * (1.0 + 2.0**-40) for j in range(3)]
+
+    def enclosure(self, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray, deriv: int) -> Interval:
+        """Enclosure of d^deriv f / dphi^deriv over (box owner, piece [lo, hi]).
+
+        Mean value in phi, f(R, phi_m) + d_phi f(R, Phi) (Phi - phi_m), intersected
+        with the natural form f(R, Phi); each with the exact Taylor form in r.
+        """
+        taylor = self.taylor[owner]
+        half = self.half[owner]
+        piece = Ball.from_interval(Interval(lo, hi))
+
+        def over_r(w: Ball, j: int) -> Ball:
+            t = Ball(w.mid[:, None, :], w.rad[:, None, :]).dot(taylor)  # (m, 4)
+            spread = np.einsum("mi,mi->m", np.abs(t.mid[:, 1:]) + t.rad[:, 1:], half)
+            extra = (spread + self.second[j][owner]) * (1.0 + 2.0**-40) + 2.0**-1000
+            return Ball(t.mid[:, 0], t.rad[:, 0] + extra)
+
+        at_mid = over_r(_basis(Ball.point(piece.mid), deriv), deriv)
+        slope = over_r(_basis(piece, deriv + 1), deriv + 1)
+        mv = (at_mid + slope * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
+        natural = over_r(_basis(piece, deriv), deriv).to_interval()
+        return mv.intersect(natural)
+
+
+def _stack(parts: list[Ball], axis: int = -1) -> Ball:
+    shape = np.broadcast_shapes(*(p.mid.shape for p in parts))
+    return Ball(np.stack([np.broadcast_to(p.mid, shape) for p in parts], axis=axis),
+                np.stack([np.broadcast_to(p.rad, shape) for p in parts], axis=axis))
+
+
+def clear_boxes(geometry: Geometry, boxes: np.ndarray, pieces: int = PIECES, halvings: int = HALVINGS) -> np.ndarray:
+    """Which joint boxes are clear (every root of the reduced equation simple throughout).
+
+    Parameters
+    ----------
+    geometry : the manipulator.
+    boxes : ndarray (n, 3, 2) of joint boxes [rho_lo, rho_hi] (rho > 0).
+
+    Returns
+    -------
+    (n,) bool: True where the box is PROVED clear, so that the number of
+    direct-kinematic solutions and their split between the aspects are the same
+    at every point of it (module docstring).  False means undecided, not "on g(S)".
+    """
+    boxes = np.asarray(boxes, dtype=np.float64)
+    n = len(boxes)
+    if n == 0:
+        return np.zeros(0, dtype=bool)
+    data = _Boxes(geometry, boxes)
+    cuts = np.linspace(-PI_HI, PI_HI, pieces + 1)
+    cuts[0], cuts[-1] = -PI_HI, PI_HI  # the pieces cover the whole circle
+    owner = np.repeat(np.arange(n), pieces)
+    lo = np.tile(cuts[:-1], n)
+    hi = np.tile(cuts[1:], n)
+    undecided = np.zeros(n, dtype=bool)
+    for round_ in range(halvings + 1):
+        f = data.enclosure(owner, lo, hi, 0)
+        open_ = (f.lo <= 0) & (f.hi >= 0)
+        if np.any(open_):
+            idx = np.flatnonzero(open_)
+            slope = data.enclosure(owner[idx], lo[idx], hi[idx], 1)
+            open_[idx] = (slope.lo <= 0) & (slope.hi >= 0)
+        owner, lo, hi = owner[open_], lo[open_], hi[open_]
+        crowded = np.bincount(owner, minlength=n) > _CROWD
+        if round_ == halvings:
+            crowded |= np.bincount(owner, minlength=n) > 0
+        undecided |= crowded
+        keep = ~undecided[owner]
+        owner, lo, hi = owner[keep], lo[keep], hi[keep]
+        if owner.size == 0:
+            break
+        mid = np.minimum(np.maximum(0.5 * lo + 0.5 * hi, lo), hi)
+        owner = np.concatenate([owner, owner])
+        lo, hi = np.concatenate([lo, mid]), np.concatenate([mid, hi])
+    return ~undecided
