@@ -33,6 +33,7 @@ from intervalkin.kinematics.formulas import (
     quadratic,
     rho_sq_arb,
 )
+from intervalkin.paving.predicates import pave_workspace
 
 from .conftest import DATA
 
@@ -156,8 +157,6 @@ def test_centred_form_sharpens_small_boxes(paper_geometry):
 
 def test_phi_tight_det_is_sharper_than_natural_form(paper_geometry):
     """On the leaves of a depth-6 paving the phi-tight form beats the natural form of the same formula."""
-    from intervalkin.paving.predicates import pave_workspace
-
     p = pave_workspace(paper_geometry, 6)
     b = p.boxes[p.level == p.depth][:5000]
     old = _natural_det(paper_geometry, b)

@@ -133,3 +133,20 @@ def test_checks_fail_when_rounding_is_switched_off(monkeypatch):
     # and the simplest case of all, spelled out
     s = Interval.point(0.1) + Interval.point(0.2)
     assert Fraction(float(s.lo)) > Fraction(0.1) + Fraction(0.2)
+
+
+def test_integer_operands_that_round_are_widened():
+    """An int beyond 2**53 is not a float: its conversion rounds, so it enters as a one-ulp interval."""
+    n = 2**60 + 1
+    s = Interval.point(0.0) + n
+    assert Fraction(float(s.lo)) <= n <= Fraction(float(s.hi))
+    s = Interval.point(np.zeros(2)) + np.array([2**60 + 1, 3], dtype=np.int64)
+    assert Fraction(float(s.lo[0])) <= 2**60 + 1 <= Fraction(float(s.hi[0]))
+
+
+def test_foreign_operands_are_refused():
+    """A Fraction is not silently rounded to a float point: the operation is refused."""
+    with pytest.raises(TypeError):
+        Interval.point(1.0) + Fraction(1, 3)
+    with pytest.raises(TypeError):
+        Fraction(1, 3) * Interval.point(1.0)

@@ -72,12 +72,21 @@ _POINT_TYPES = (float, int, np.ndarray, np.floating, np.integer)
 
 
 def _as_interval(v: Operand) -> "Interval | None":
-    """v as an Interval (a float is the exact number it represents: a point), None for other types."""
+    """v as an Interval, None for other types (the caller returns NotImplemented).
+
+    A float is the exact number it represents (a point).  An integer above 2**53 in
+    magnitude may round when converted to float (to nearest), so it gets one ulp on
+    each side.
+    """
     if isinstance(v, Interval):
         return v
     if not isinstance(v, _POINT_TYPES):
         return None
     a = np.asarray(v, dtype=np.float64)
+    if isinstance(v, (int, np.integer)) or (isinstance(v, np.ndarray) and v.dtype.kind in "iuO"):
+        big = np.abs(a) > 2.0**53
+        if np.any(big):
+            return Interval(np.where(big, round_down(a), a), np.where(big, round_up(a), a))
     return Interval(a, a)
 
 

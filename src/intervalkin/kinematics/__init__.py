@@ -4,6 +4,7 @@ constants    the geometry's constants as floats, outward intervals and arb balls
 formulas     g (rho_i^2), the Jacobian A and det A: the formulas, and their float and arb versions
 enclosures   certified interval enclosures of rho_i^2, A (= grad rho_i^2), det A and grad det A over boxes
 sextic       the reduction of the direct kinematics to one polynomial in t = tan(phi / 2)
+reduced_equation  that reduction's coefficients as quadratics in r = rho^2 (for joint-space boxes)
 
 Layer: imports only :mod:`intervalkin.core`; everything above evaluates kinematics through here.
 """

@@ -24,11 +24,13 @@ sound enclosures:
 3. monotonicity: where f_phi(b) has a certified sign, f over b lies between its
    enclosures on the faces phi = phi_lo and phi = phi_hi.
 
-At fixed phi (or with the phi parts as intervals) the (x, y) part is enclosed
-without overestimation from the dependency problem: rho_i^2 = (d_ix + r_ix)^2 +
-(d_iy + r_iy)^2 is a sum of squares of independent terms; w_i = r_ix d_iy - r_iy d_ix is
-linear in (x, y); Q is written as its exact second-order Taylor expansion at the centre
-m of the (x, y) rectangle, Q(m) + grad Q(m) . (u, v) + a u^2 + b u v + c v^2.
+At fixed phi (or with the phi parts as intervals) the (x, y) part is enclosed with
+little or no dependency overestimation: rho_i^2 = (d_ix + r_ix)^2 + (d_iy + r_iy)^2 is a
+sum of squares of independent terms (exact range); w_i = r_ix d_iy - r_iy d_ix is linear
+in (x, y) (exact range); Q is written as its exact second-order Taylor expansion at the
+centre m of the (x, y) rectangle, Q(m) + grad Q(m) . (u, v) + a u^2 + b u v + c v^2 with
+u, v the offsets from m (the overestimation is of second order in the box width).
+Boxes that are points in phi take the natural form alone (the three forms coincide).
 
 The derivatives in phi come from the formulas: d r_i / d phi = (-r_iy, r_ix), so
 d rho_i^2 / d phi = 2 w_i and d w_i / d phi = -(r_i . d_i); the coefficients of Q are

@@ -60,6 +60,8 @@ PIECES = 24
 HALVINGS = 7
 #: A box with more unsettled pieces than this at some round is undecided at once (it straddles g(S)).
 _CROWD = 24
+#: Boxes tested together (memory: about 40 kB per box at the first round).
+_CHUNK = 4096
 
 
 def _basis(phi: Ball, deriv: int) -> Ball:
@@ -167,6 +169,9 @@ def clear_boxes(geometry: Geometry, boxes: np.ndarray, pieces: int = PIECES, hal
     at every point of it (module docstring).  False means undecided, not "on g(S)".
     """
     boxes = np.asarray(boxes, dtype=np.float64)
+    if len(boxes) > _CHUNK:  # bounded memory: the pieces of one chunk are in flight at a time
+        return np.concatenate([clear_boxes(geometry, boxes[k:k + _CHUNK], pieces, halvings)
+                               for k in range(0, len(boxes), _CHUNK)])
     n = len(boxes)
     if n == 0:
         return np.zeros(0, dtype=bool)
