@@ -22,6 +22,7 @@ import intervalkin
 from intervalkin import Count, InputError, Status
 from intervalkin.certify.writer import write_certificates
 from intervalkin.solve import dkp
+from intervalkin.space.pose_label import boxes_holding
 
 TABLE1_RHO = ("14.98", "15.38", "12.0")
 
@@ -184,6 +185,25 @@ def test_label_outside_and_undecided(analysis):
     assert far.boxes == 0 and far.status is Status.UNDECIDED and far.basic_region is None
     with pytest.raises(InputError, match="^pose: "):
         analysis.label(("1", "2", "x"))
+
+
+def test_boxes_holding_is_exact_next_to_an_inexact_decimal():
+    """boxes_holding finds exactly the closed boxes around an exact pose that no float equals.
+
+    1/10 lies strictly between the floats d < 1/10 < u = float(0.1): boxes ending at d
+    or starting at u do not hold it; boxes ending at u or starting at d do.  Would catch the
+    float filter taken for the exact test (box [u, 1] kept for 1/10), a filter or test with
+    open bounds (boxes meeting the pose u at a face lost), or an enclosure of 1/10 that
+    misses it.
+    """
+    u = 0.1
+    d = float(np.nextafter(u, -np.inf))
+    assert Fraction(d) < Fraction(1, 10) < Fraction(u)
+    lo = np.array([[0.0, 0, 0], [u, 0, 0], [0.0, 0, 0], [d, 0, 0], [d, 0, 0]])
+    hi = np.array([[d, 1, 1], [1.0, 1, 1], [u, 1, 1], [1.0, 1, 1], [u, 1, 1]])
+    pose = (Fraction(1, 10), Fraction(1, 2), Fraction(1, 2))
+    assert boxes_holding(lo, hi, pose).tolist() == [2, 3, 4]
+    assert boxes_holding(lo, hi, (Fraction(u), Fraction(0), Fraction(1))).tolist() == [1, 2, 3, 4]
 
 
 def test_label_of_table1_solutions_lies_in_their_aspect(analysis):

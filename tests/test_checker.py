@@ -115,13 +115,20 @@ def test_hex_boxes_round_trip_exactly():
             _hex_box(bad, "end")
 
 
-@pytest.mark.xfail(strict=True, reason="bug: checker.parse.read_hex reads a decimal-looking string such as \"1.5\" "
-                                       "as the hex number 0x1.5 = 1.3125 (float.fromhex accepts it without the "
-                                       "0x prefix), so a hand-edited file is silently reinterpreted")
 def test_hex_box_refuses_decimal_looking_strings():
-    """A bound written "1.5" is not a hex float as float.hex writes it ("0x1.8000000000000p+0"): refused."""
-    with pytest.raises(_Refused):
+    """A bound written "1.5" is not a hex float as float.hex writes it ("0x1.8000000000000p+0"): refused.
+
+    float.fromhex alone would read "1.5" as 0x1.5 = 1.3125, silently reinterpreting a
+    hand-edited file.  Signed hex strings and exponents past binary64 are covered too.
+    """
+    with pytest.raises(_Refused, match="not a hex float"):
         _hex_box([["1.5", "2.5"]] * 3, "end")
+    for bad in ["15", " 0x1p+0", "-1.5p+0"]:
+        with pytest.raises(_Refused, match="not a hex float"):
+            _hex_box([[bad, "0x1p+4"]] * 3, "end")
+    with pytest.raises(_Refused, match="not finite"):
+        _hex_box([["0x1p+0", "0x1p+99999"]] * 3, "end")
+    assert _hex_box([["-0x1.8p+0", "+0x1p+0"]] * 3, "end") == ((-1.5, 1.0),) * 3
 
 
 # --------------------------------------------------------------------------------------

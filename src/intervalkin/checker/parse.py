@@ -20,6 +20,7 @@ from __future__ import annotations
 import decimal
 import hashlib
 import math
+import re
 from fractions import Fraction
 from typing import Any
 
@@ -37,6 +38,10 @@ INDEX = "index.json"
 PREC_RANGE = (53, 4096)
 #: The aspect names of the files, and the sign of det A each stands for.
 ASPECT_SIGN = {"WA1": 1, "WA2": -1}
+
+#: A hex float as ``float.hex`` writes it: optional sign, then ``0x`` (or inf/nan, refused as not finite).
+#: ``float.fromhex`` alone would also take "1.5", reading it as 0x1.5 = 1.3125.
+_HEX_FLOAT = re.compile(r"[+-]?(0x[0-9a-f]+(\.[0-9a-f]*)?(p[+-]?[0-9]+)?|inf|nan)", re.IGNORECASE)
 
 #: A box [[xlo, xhi], [ylo, yhi], [philo, phihi]] as read: three (lo, hi) float pairs.
 Box = tuple[tuple[float, float], ...]
@@ -94,10 +99,12 @@ def read_hex(v: Any, what: str) -> float:
     """A binary64 number written exactly as a hex string ("0x1.8p+3", float.hex)."""
     if not isinstance(v, str):
         raise Refused(f"{what}: expected an exact hex float string such as \"0x1.8p+3\", got {v!r}")
+    if not _HEX_FLOAT.fullmatch(v):
+        raise Refused(f"{what}: {v!r} is not a hex float (expected a sign, if any, then 0x)")
     try:
         f = float.fromhex(v)
-    except ValueError:
-        raise Refused(f"{what}: {v!r} is not a hex float") from None
+    except OverflowError:
+        raise Refused(f"{what}: {v!r} is not finite (beyond binary64)") from None
     if not math.isfinite(f):
         raise Refused(f"{what}: {v!r} is not finite")
     return f

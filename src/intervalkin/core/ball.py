@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from intervalkin.core.interval import TRIG_ABS_ERROR, TRIG_MAX_ARG, Interval
+from intervalkin.core.interval import TRIG_ABS_ERROR, TRIG_MAX_ARG, Interval, round_down, round_up
 
 __all__ = ["Ball", "REL", "TINY"]
 
@@ -68,7 +68,7 @@ class Ball:
 
     def to_interval(self) -> Interval:
         """[mid - rad, mid + rad], rounded outward."""
-        return Interval(np.nextafter(self.mid - self.rad, -np.inf), np.nextafter(self.mid + self.rad, np.inf))
+        return Interval(round_down(self.mid - self.rad), round_up(self.mid + self.rad))
 
     def magnitude(self) -> np.ndarray:
         """An upper bound of |x| over the ball (up to the REL inflation of the caller)."""

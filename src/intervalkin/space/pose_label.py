@@ -3,9 +3,9 @@
 A pose X = (x, y, phi) is read exactly (decimal text or Fractions; phi in
 radians, in the paving's range [-pi, pi]: it is not reduced modulo 2 pi, which
 cannot be done exactly).  The boxes of a paving that contain it are found by an
-exact test: a float filter that cannot lose a box (the float nearest to each
-coordinate is off by less than one ulp, so the bounds are compared with the
-neighbouring floats), then a comparison of the box bounds, read as exact
+exact test: a float filter that cannot lose a box (each coordinate is enclosed
+by floats lo <= v <= hi from the rounding layer, and the box bounds are compared
+with those), then a comparison of the box bounds, read as exact
 binary fractions, with the exact pose.  A box is closed, so a pose on a shared
 face lies in every box around it, and each of them is consulted.
 
@@ -27,6 +27,7 @@ from typing import Sequence
 import numpy as np
 
 from intervalkin.core.errors import InputError
+from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.status import Status
 
 __all__ = ["PoseLabel", "read_pose", "boxes_holding", "label_from_boxes"]
@@ -82,12 +83,11 @@ def read_pose(values: Sequence) -> Pose:
 def boxes_holding(lo: np.ndarray, hi: np.ndarray, pose: Pose) -> np.ndarray:
     """Indices of the closed boxes [lo, hi] (arrays (n, 3)) that contain the exact pose.
 
-    The float filter keeps every box whose bounds reach the floats on either side
-    of the nearest float to each coordinate (the exact value lies between them);
+    The float filter keeps every box that meets the float enclosure
+    [below, above] of each coordinate (:func:`~intervalkin.core.exact.fraction_bounds`);
     the kept few are then tested exactly.
     """
-    near = np.array([float(v) for v in pose])
-    below, above = np.nextafter(near, -np.inf), np.nextafter(near, np.inf)
+    below, above = np.array([fraction_bounds(v) for v in pose]).T
     candidates = np.flatnonzero(np.all((lo <= above) & (below <= hi), axis=1))
     hits = [int(i) for i in candidates
             if all(Fraction(float(lo[i, j])) <= pose[j] <= Fraction(float(hi[i, j])) for j in range(3))]
