@@ -4,11 +4,14 @@
   checker imports nothing it checks, and not numpy) hold;
 - ``import intervalkin`` and ``import intervalkin.checker`` stay light: neither
   loads numpy nor the paving code, so the checker is independent of what it checks;
-- no module grows past the size where it stops holding one concept.
+- no module grows past the size where it stops holding one concept;
+- a helper shared between modules is public where it lives: no module imports another's
+  private (``_name``) definitions.
 """
 
 from __future__ import annotations
 
+import ast
 import shutil
 import subprocess
 import sys
@@ -49,3 +52,14 @@ def test_layers_are_folders():
     assert {"core", "kinematics", "paving", "solve", "space", "certify", "checker", "app"} <= layers
     loose = sorted(p.name for p in PACKAGE.glob("*.py"))
     assert loose == ["__init__.py", "__main__.py", "pipeline.py"], loose
+
+
+def test_no_module_imports_a_private_name_of_another():
+    found = {}
+    for p in PACKAGE.rglob("*.py"):
+        for node in ast.walk(ast.parse(p.read_text())):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("intervalkin"):
+                names = {a.name for a in node.names if a.name.startswith("_") and not a.name.startswith("__")}
+                if names:
+                    found.setdefault(str(p.relative_to(PACKAGE)), set()).update(names)
+    assert not found, found

@@ -22,7 +22,7 @@ from intervalkin.checker.solutions import disjoint_mod_2pi as _disjoint_mod_2pi
 from intervalkin.checker.solutions import reduced_sextic as _reduced_sextic
 from intervalkin.certify.writer import write_certificates
 from intervalkin.app.cli import main
-from intervalkin.kinematics.sextic import _poly_t, _reduce
+from intervalkin.kinematics.sextic import reduction, sextic_coefficients
 from .approx import approx_solve
 from intervalkin.solve.dkp import parse_joint_vector, solve
 from intervalkin.core.geometry import load_geometry
@@ -168,7 +168,7 @@ def test_reduced_sextic_agrees_with_the_solver_derivation(paper_geometry, rng):
             with ctx.workprec(128):
                 rs = [_q(r * r) for r in rho]
                 mine = _reduced_sextic(_Model(paper_geometry), rs, phi0)
-                theirs = _poly_t(_reduce(paper_geometry, rs), phi0)
+                theirs = sextic_coefficients(reduction(paper_geometry, rs), phi0)
             assert all(a.overlaps(b) for a, b in zip(mine, theirs))
 
 

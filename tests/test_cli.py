@@ -14,7 +14,9 @@ import sys
 import pytest
 
 from intervalkin.app.cli import build_parser, main
+from intervalkin.certify.writer import write_certificates
 from intervalkin.core.geometry import default_geometry
+from intervalkin.solve.dkp import parse_joint_vector, solve
 
 TABLE1 = ["14.98", "15.38", "12.0"]
 SUBCOMMANDS = ("dkp", "table1", "pave", "joint", "analyze", "paper", "label", "trajectory", "verify")
@@ -112,8 +114,9 @@ def test_bad_geometry_file_is_refused_by_every_command(command, bad_geometries, 
     (["dkp", "15", "15", "1e999999"], "rho_3"),
     (["trajectory", "--rho", "15", "nan", "15", "--from", "1", "--to", "2"], "rho_2"),
     (["trajectory", "--rho", "40", "15", "15", "--from", "1", "--to", "2"], "rho_1"),
-    (["trajectory", "--rho", *TABLE1, "--from", "2", "--to", "7"], "--to"),
-    (["trajectory", "--rho", *TABLE1, "--from", "0", "--to", "3"], "--from"),
+    (["trajectory", "--rho", *TABLE1, "--from", "2", "--to", "7"], "--to: expected a solution number"),
+    (["trajectory", "--rho", *TABLE1, "--from", "0", "--to", "3"], "--from: expected a solution number"),
+    (["trajectory", "--rho", *TABLE1, "--from", "3", "--to", "3"], "--from and --to both name solution 3"),
     (["trajectory", "--rho", *TABLE1, "--from", "1", "--to", "2"], "different aspects"),
     (["label", "1", "2", "nan", "--depth", "3"], "pose"),
     (["label", "1", "2", "x", "--from", "/nonexistent"], "pose"),
@@ -192,6 +195,24 @@ def test_verify_refuses_what_is_not_a_certificate_folder(tmp_path, capsys):
     for target in (tmp_path / "nowhere", f, tmp_path):
         assert _run(["verify", str(target)]) == 2
         _one_line_error(capsys)
+
+
+def test_verify_accepts_an_output_folder_or_its_certificates(tmp_path, capsys):
+    """verify DIR and verify DIR/certificates check the same claims: status 0, the same lines.
+
+    Would catch the command reading DIR alone again (status 2, "index.json missing" for an
+    output folder), as the README's one-liner on an output folder needs it not to.
+    """
+    certificates = tmp_path / "run" / "certificates"
+    g = default_geometry()
+    write_certificates(certificates, g, dkp_results=[solve(g, parse_joint_vector(g, TABLE1))])
+    outputs = []
+    for target in (tmp_path / "run", certificates):
+        assert _run(["verify", str(target)]) == 0
+        out, err = capsys.readouterr()
+        assert out and err.endswith("claims verified\n") and "error" not in err, err
+        outputs.append(out)
+    assert outputs[0] == outputs[1]
 
 
 def test_label_of_a_pose_beyond_float_range_is_bad_input(tmp_path, capsys):

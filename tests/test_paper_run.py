@@ -48,7 +48,19 @@ def test_run_succeeds_quietly(run):
     assert r.returncode == 0, r.stderr
     assert r.stdout == ""
     assert "Traceback" not in r.stderr and "error" not in r.stderr.lower()
+    assert "Warning:" not in r.stderr, r.stderr
     assert seconds < 120
+
+
+def test_shallow_run_warns_of_nothing(tmp_path):
+    """At depth 3 no joint cell has a certified count: the figures are drawn all the same, and
+    --quiet leaves stderr without a Python warning (e.g. matplotlib's "No artists with labels"
+    from a legend over an empty scatter)."""
+    r = subprocess.run([sys.executable, "-m", "intervalkin", "paper", "--depth", "3", "--out", str(tmp_path / "run"),
+                        "--quiet"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "Warning:" not in r.stderr, r.stderr
+    assert (tmp_path / "run" / "figures" / "joint_3d.png").is_file()
 
 
 def test_documented_files_are_written_completely(run, summary):

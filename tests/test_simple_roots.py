@@ -24,7 +24,7 @@ from intervalkin.core.ball import Ball, cos_sin_multiple
 from intervalkin.core.geometry import load_geometry
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.reduced_equation import HARMONICS, MONOMIALS, reduced_equation
-from intervalkin.kinematics.sextic import _leval, _reduce
+from intervalkin.kinematics.sextic import laurent_value, reduction
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.simple_roots import clear_boxes
 
@@ -50,7 +50,7 @@ def test_reduced_equation_matches_the_solver_reduction(paper_geometry):
         for _ in range(20):
             r = [Fraction(int(v), 7) for v in rng.integers(700, 7200, 3)]
             phi = float(rng.uniform(-np.pi, np.pi))
-            exact = _leval(_reduce(paper_geometry, [arb(fmpq(v.numerator, v.denominator)) for v in r]).f, _q(phi)).real
+            exact = laurent_value(reduction(paper_geometry, [arb(fmpq(v.numerator, v.denominator)) for v in r]).f, _q(phi)).real
             mono = [Fraction(1) if not e else r[e[0]] if len(e) == 1 else r[e[0]] * r[e[1]] for e in MONOMIALS]
             basis = [arb(1) if k == 0 else (_q(phi) * k).sin() if s else (_q(phi) * k).cos() for k, s in HARMONICS]
             total = arb(0)

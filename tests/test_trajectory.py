@@ -202,8 +202,10 @@ def test_different_aspects_have_no_path(paper_geometry, capsys):
 def test_bad_requests_are_input_errors(paper_geometry):
     from intervalkin.core.errors import InputError
 
-    with pytest.raises(InputError, match="--to"):
+    with pytest.raises(InputError, match="^i_to: expected a solution number in 1..6"):  # the parameter, not the flag
         trajectory(paper_geometry, RHO, 2, 7, depth=4)
+    with pytest.raises(InputError, match="^i_from: "):
+        trajectory(paper_geometry, RHO, 0, 2, depth=4)
     with pytest.raises(InputError, match="same|both"):
         trajectory(paper_geometry, RHO, 3, 3, depth=4)
     with pytest.raises(InputError, match="rho_1"):

@@ -19,9 +19,8 @@ from intervalkin.app.label import run_label
 from intervalkin.app.options import geometry_from_option
 from intervalkin.app.table1 import format_table1, table1_comparison
 from intervalkin.app.text import format_dkp_table
-from intervalkin.checker.folder import verify_directory
 from intervalkin.core.errors import IntervalkinError
-from intervalkin.pipeline import DEFAULT_DEPTH
+from intervalkin.pipeline import DEFAULT_DEPTH, verify
 from intervalkin.solve.dkp import parse_joint_vector, solve
 
 __all__ = ['build_parser', 'main']
@@ -43,7 +42,6 @@ def _print_json(obj) -> None:
 # Sub-commands
 # --------------------------------------------------------------------------------------
 def _cmd_dkp(args: argparse.Namespace) -> int:
-
     geometry = geometry_from_option(args.geometry)
     rho = parse_joint_vector(geometry, args.rho)
     result = solve(geometry, rho)
@@ -55,7 +53,6 @@ def _cmd_dkp(args: argparse.Namespace) -> int:
 
 
 def _cmd_table1(args: argparse.Namespace) -> int:
-
     comparison = table1_comparison()
     if args.json:
         _print_json(comparison.to_json())
@@ -65,41 +62,34 @@ def _cmd_table1(args: argparse.Namespace) -> int:
 
 
 def _cmd_pave(args: argparse.Namespace) -> int:
-
     return run_pave(geometry_path=args.geometry, depth=args.depth, out=args.out)
 
 
 def _cmd_joint(args: argparse.Namespace) -> int:
-
     return run_joint(args.geometry, args.depth, args.out, force=args.force, quiet=args.quiet)
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-
     return run_analyze(args.geometry, args.depth, args.out, force=args.force, quiet=args.quiet, as_json=args.json,
                        refine_to=args.refine_to)
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:
-
     return run_analyze(None, args.depth, args.out, force=args.force, quiet=args.quiet, as_json=args.json, paper=True,
                        refine_to=args.refine_to)
 
 
 def _cmd_label(args: argparse.Namespace) -> int:
-
     return run_label(args.geometry, args.pose, args.depth, source=args.source, as_json=args.json)
 
 
 def _cmd_trajectory(args: argparse.Namespace) -> int:
-
     return run_trajectory(args.geometry, args.rho, args.i_from, args.i_to, depth=args.depth, out=args.out,
                           as_json=args.json)
 
 
 def _cmd_verify(args: argparse.Namespace) -> int:
-
-    results = verify_directory(args.dir)
+    results = verify(args.dir).results  # DIR: the certificate folder, or an output folder holding one
     for r in results:
         sys.stdout.write(r.line() + "\n")
     failed = sum(1 for r in results if not r.verified)
@@ -182,7 +172,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("verify", help="re-check a certificate folder with the independent checker (arb only)")
-    p.add_argument("dir", metavar="DIR", help="folder holding index.json and the claim files")
+    p.add_argument("dir", metavar="DIR",
+                   help="folder holding index.json and the claim files, or an output folder holding certificates/")
     return parser
 
 

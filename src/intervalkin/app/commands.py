@@ -12,6 +12,7 @@ anything: every claim printed or written comes from the library's results.
 from __future__ import annotations
 
 import json
+import re
 import sys
 import time
 from pathlib import Path
@@ -166,6 +167,19 @@ def _paper_trajectories(a: Analysis, out: Path, files: list[str]) -> tuple[list[
     return done, found
 
 
+#: The parameters of :func:`~intervalkin.space.trajectory.trajectory` and the flags that set them.
+_TRAJECTORY_FLAGS = {"i_from": "--from", "i_to": "--to"}
+
+
+def _check_trajectory_request(geometry, rho, i_from: int, i_to: int) -> None:
+    """``check_request``, its message naming the command's flags where the library names parameters."""
+    try:
+        check_request(geometry, rho, i_from, i_to)
+    except IntervalkinError as exc:
+        text = re.sub(r"\b(i_from|i_to)\b", lambda m: _TRAJECTORY_FLAGS[m.group(1)], str(exc))
+        raise type(exc)(text) from None
+
+
 def run_trajectory(geometry_path, rho, i_from: int, i_to: int, depth: int = 7, out=None,
                    as_json: bool = False, quiet: bool = False) -> int:
     """``intervalkin trajectory``: the chain at ``depth``, then a certified path between two solutions.
@@ -174,7 +188,7 @@ def run_trajectory(geometry_path, rho, i_from: int, i_to: int, depth: int = 7, o
     once, before any paving).
     """
     geometry = geometry_from_option(geometry_path)
-    check_request(geometry, rho, i_from, i_to)
+    _check_trajectory_request(geometry, rho, i_from, i_to)
     check_chain_depth(depth)
     if out is not None:
         earlier = Path(out).is_dir() and (Path(out) / MARKER).exists()

@@ -62,6 +62,16 @@ def _subsample(idx: np.ndarray, limit: int, rng) -> np.ndarray:
     return np.sort(rng.choice(idx, size=limit, replace=False))
 
 
+def _opaque_legend(ax, markerscale: float) -> bool:
+    """A legend with opaque markers when some artist of ``ax`` has a label; whether one was drawn."""
+    if not ax.get_legend_handles_labels()[0]:
+        return False
+    leg = ax.legend(loc="upper left", fontsize=8, markerscale=markerscale)
+    for h in leg.legend_handles:
+        h.set_alpha(1)
+    return True
+
+
 def render_3d(paving: Paving, layers, path, title: str, max_points: int = 40000, seed: int = 0):
     """Scatter of box centres in (x, y, phi) for each (mask, colour, name) layer; one PNG."""
     plt = pyplot()
@@ -85,11 +95,7 @@ def render_3d(paving: Paving, layers, path, title: str, max_points: int = 40000,
     ax.set_zlim(-np.pi, np.pi)
     ax.view_init(elev=22, azim=-60)
     ax.set_title(title, fontsize=11)
-    if ax.get_legend_handles_labels()[0]:
-        leg = ax.legend(loc="upper left", fontsize=8, markerscale=4)
-        for h in leg.legend_handles:
-            h.set_alpha(1)
-    else:
+    if not _opaque_legend(ax, markerscale=4):
         ax.text2D(0.05, 0.95, "no certified box at this depth", transform=ax.transAxes, fontsize=9)
     fig.tight_layout()
     written = save_png(fig, path)
@@ -245,9 +251,7 @@ def render_joint(joint, out_dir, max_points: int = 60000, seed: int = 0) -> list
     ax.set_zlabel("rho3")
     ax.set_title(f"Joint space: certified cells by number of solutions\n(voxels 2^-{joint.depth}; cf. paper Figs. 2, 11)",
                  fontsize=10)
-    leg = ax.legend(loc="upper left", fontsize=8, markerscale=5)
-    for h in leg.legend_handles:
-        h.set_alpha(1)
+    _opaque_legend(ax, markerscale=5)  # none when no cell has a certified count (shallow depths)
     fig.tight_layout()
     p3 = save_png(fig, out / "joint_3d.png")
     plt.close(fig)

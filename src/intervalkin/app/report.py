@@ -127,7 +127,7 @@ def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
 
     a("## Characteristic surfaces and basic regions (Figures 9, 10)\n")
     br = summary["basic_regions"]
-    a(f"The paper counts 28 basic regions. Here the basic regions are the sheets above the joint cells that "
+    a("The paper counts 28 basic regions. Here the basic regions are the sheets above the joint cells that "
       f"carry certified boxes: {br['count']} ({br['why']}).\n")
     realized = sorted({r.cell for r in ra.regions})
     parts = {}

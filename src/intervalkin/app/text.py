@@ -9,7 +9,8 @@ the printed digits.
 
 from __future__ import annotations
 
-from intervalkin.solve.dkp import DkpResult, _fmt_fraction
+from intervalkin.core.exact import exact_text
+from intervalkin.solve.dkp import DkpResult
 
 __all__ = ['format_dkp_table']
 
@@ -23,7 +24,7 @@ def format_dkp_table(result: DkpResult) -> str:
     Columns: x, y, phi (box midpoints, 12 decimals), the largest enclosure
     width, sign of det A, aspect, status; then whether completeness was proved.
     """
-    rho = ", ".join(_fmt_fraction(r) for r in result.rho)
+    rho = ", ".join(exact_text(r) for r in result.rho)
     lines = [f"rho = ({rho}): {result.count} solution(s)"]
     head = f"{'#':>2}  {'x':>18}  {'y':>18}  {'phi (rad)':>16}  {'width':>8}  {'det A':>5}  {'aspect':>6}  status"
     lines.append(head)

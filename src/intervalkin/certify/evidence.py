@@ -2,7 +2,8 @@
 
 The fields follow the conventions of the file format (:mod:`intervalkin.certify.writer`):
 joint vectors as exact decimal strings (``"14.98"``, or ``"p/q"`` when the
-rational has no finite decimal form), boxes as lists of binary64 bounds.
+rational has no finite decimal form; :func:`intervalkin.core.exact.exact_text`),
+boxes as lists of binary64 bounds.
 
 A solver box is tight around its solution, and the checker re-proves it with its
 own preconditioner and arithmetic, which may need a little more room; the
@@ -24,10 +25,11 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from intervalkin.checker import check_claim
+from intervalkin.core.exact import exact_text
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import round_down, round_up
 
-__all__ = ['PHI0', 'PRECISIONS', 'PADS', 'exact_text', 'rho_text', 'box_json', 'pad_box', 'labels_of', 'certified']
+__all__ = ['PHI0', 'PRECISIONS', 'PADS', 'rho_text', 'box_json', 'pad_box', 'labels_of', 'certified']
 
 #: Shifts phi0 tried for the reduced sextic (its leading coefficient f(phi0 + pi) must be non-zero).
 PHI0 = (0.0,) + tuple(round(j * math.pi / 6, 6) for j in range(1, 12))
@@ -35,24 +37,6 @@ PHI0 = (0.0,) + tuple(round(j * math.pi / 6, 6) for j in range(1, 12))
 PRECISIONS = (128, 256, 512)
 #: Relative paddings tried around a solver box when the tight box does not pass the checker's Krawczyk test.
 PADS = (0.0, 1e-13, 1e-11)
-
-
-def exact_text(q: Fraction) -> str:
-    """The exact decimal "14.98" when the denominator divides a power of ten, else "p/q"."""
-    q = Fraction(q)
-    d, twos, fives = q.denominator, 0, 0
-    while d % 2 == 0:
-        d, twos = d // 2, twos + 1
-    while d % 5 == 0:
-        d, fives = d // 5, fives + 1
-    if d != 1:
-        return f"{q.numerator}/{q.denominator}"
-    digits = max(twos, fives)
-    if digits == 0:
-        return str(q.numerator)
-    scaled = abs(q.numerator) * 10**digits // q.denominator
-    sign = "-" if q < 0 else ""
-    return f"{sign}{scaled // 10**digits}.{scaled % 10**digits:0{digits}d}"
 
 
 def rho_text(rho: Sequence[Fraction]) -> str:

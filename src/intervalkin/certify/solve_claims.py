@@ -21,7 +21,8 @@ from __future__ import annotations
 
 from typing import Sequence
 
-from intervalkin.certify.evidence import box_json, certified, exact_text, rho_text
+from intervalkin.certify.evidence import box_json, certified, rho_text
+from intervalkin.core.exact import exact_text
 from intervalkin.core.geometry import Geometry
 from intervalkin.solve.dkp import solve
 

@@ -25,12 +25,12 @@ import numpy as np
 from intervalkin.certify.evidence import (
     box_json,
     certified,
-    exact_text,
     labels_of,
     rho_text,
 )
 from intervalkin.checker import box_label_proved, check_claim, sample_indices
 from intervalkin.checker.parse import inside
+from intervalkin.core.exact import exact_text
 from intervalkin.core.geometry import Geometry
 from intervalkin.paving.labels import Label
 from intervalkin.solve.dkp import solve

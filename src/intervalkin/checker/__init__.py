@@ -86,10 +86,10 @@ from intervalkin.checker.parse import (
     INDEX,
     KINDS,
     VERSION,
-    CertificateFormatError,
     parse_exact,
     sample_indices,
 )
+from intervalkin.core.errors import CertificateFormatError
 
 __all__ = [
     "FORMAT",

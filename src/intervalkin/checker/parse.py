@@ -24,9 +24,7 @@ import re
 from fractions import Fraction
 from typing import Any
 
-from intervalkin.core.errors import CertificateFormatError
-
-__all__ = ['FORMAT', 'VERSION', 'KINDS', 'INDEX', 'CertificateFormatError', 'Refused', 'parse_exact',
+__all__ = ['FORMAT', 'VERSION', 'KINDS', 'INDEX', 'Refused', 'parse_exact',
            'sample_indices']
 
 FORMAT = "intervalkin-certificate"

@@ -1,4 +1,4 @@
-"""Exact numbers to float bounds: the scalar half of the rounding layer, standard library only.
+"""Exact numbers to float bounds (the scalar half of the rounding layer) and to text, standard library only.
 
 The geometry is data read as exact decimals (:class:`fractions.Fraction`, square
 roots of rationals) and the trusted arithmetic is arb; float64 intervals enter the
@@ -13,6 +13,9 @@ vectorized code through the two functions here.  Both return a pair of floats
   their conversion to float is within one ulp, so one ulp further out (one
   ``math.nextafter`` step) is an enclosure.  A non-finite ball gives (-inf, inf).
 
+:func:`exact_text` writes a rational exactly, as a decimal when it has one ("14.98"),
+else as "p/q": the form of the certificates and of the limits named in messages.
+
 This module imports neither numpy nor flint (an arb ball is only asked for its
 end points), so the geometry parser and the independent checker can use it.  The
 array half of the rounding layer is :mod:`intervalkin.core.interval`; nothing
@@ -24,7 +27,7 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
-__all__ = ['fraction_bounds', 'arb_to_bounds']
+__all__ = ['fraction_bounds', 'arb_to_bounds', 'exact_text']
 
 
 def fraction_bounds(q: Fraction) -> tuple[float, float]:
@@ -59,3 +62,27 @@ def arb_to_bounds(x) -> tuple[float, float]:
     lo = math.nextafter(float(x.lower()), -math.inf)
     hi = math.nextafter(float(x.upper()), math.inf)
     return lo, hi
+
+
+def exact_text(q: Fraction) -> str:
+    """The exact decimal "14.98" when the denominator divides a power of ten, else "p/q".
+
+    Examples
+    --------
+    >>> exact_text(Fraction("14.980")), exact_text(Fraction(-1, 20)), exact_text(Fraction(32)), exact_text(Fraction(1, 3))
+    ('14.98', '-0.05', '32', '1/3')
+    """
+    q = Fraction(q)
+    d, twos, fives = q.denominator, 0, 0
+    while d % 2 == 0:
+        d, twos = d // 2, twos + 1
+    while d % 5 == 0:
+        d, fives = d // 5, fives + 1
+    if d != 1:
+        return f"{q.numerator}/{q.denominator}"
+    digits = max(twos, fives)
+    if digits == 0:
+        return str(q.numerator)
+    scaled = abs(q.numerator) * 10**digits // q.denominator
+    sign = "-" if q < 0 else ""
+    return f"{sign}{scaled // 10**digits}.{scaled % 10**digits:0{digits}d}"

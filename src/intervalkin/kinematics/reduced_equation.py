@@ -37,7 +37,7 @@ from flint import arb, ctx
 from intervalkin.core.exact import arb_to_bounds
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
-from intervalkin.kinematics.sextic import _reduce
+from intervalkin.kinematics.sextic import reduction
 
 __all__ = ["MONOMIALS", "HARMONICS", "ReducedEquation", "reduced_equation"]
 
@@ -87,7 +87,7 @@ def reduced_equation(geometry: Geometry) -> ReducedEquation:
 
         def at(r: tuple[int, int, int]) -> list:
             if r not in cache:
-                cache[r] = _fourier(_reduce(geometry, [arb(v) for v in r]).f)
+                cache[r] = _fourier(reduction(geometry, [arb(v) for v in r]).f)
             return cache[r]
 
         unit = ((1, 0, 0), (0, 1, 0), (0, 0, 1))

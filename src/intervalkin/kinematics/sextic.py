@@ -17,15 +17,15 @@ N = (k_2 m_3y - k_3 m_2y, m_2x k_3 - m_3x k_2), and F_1 = |z|^2 - rho_1^2 become
 
 Every solution satisfies it (N = adj(M) M z = D z, also where D = 0); where D(phi) != 0 a
 root phi gives exactly one solution z = N / D.  In omega = exp(i phi) (e_i = p_i omega)
-D, N and f are Laurent polynomials with acb coefficients (``_reduce``): D has harmonics
+D, N and f are Laurent polynomials with acb coefficients (``reduction``): D has harmonics
 -1..1, N has -1..2, and f is a real trigonometric polynomial of degree 3 (the terms of
 order 4 cancel: N has no omega^-2 term, so they are dropped structurally).  With a shift
 phi_0 and t = tan((phi - phi_0) / 2),
 
-    P(t) = (1 + t^2)^3 f(phi_0 + 2 atan t)                              (``_poly_t``)
+    P(t) = (1 + t^2)^3 f(phi_0 + 2 atan t)                              (``sextic_coefficients``)
 
 is a real polynomial of degree at most 6 with leading coefficient f(phi_0 + pi);
-``_choose_shift`` picks phi_0 with that coefficient PROVED non-zero, so that no root is
+``choose_shift`` picks phi_0 with that coefficient PROVED non-zero, so that no root is
 lost at t = infinity and deg P = 6.
 
 What is certified: the coefficients of P are arb balls that contain the exact
@@ -42,6 +42,8 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from intervalkin.core.geometry import Geometry
+
+__all__ = ['Reduction', 'reduction', 'laurent_value', 'sextic_coefficients', 'choose_shift']
 
 
 # --------------------------------------------------------------------------------------
@@ -72,7 +74,7 @@ def _lconj(p: dict) -> dict:
     return {-k: v.conjugate() for k, v in p.items()}
 
 
-def _leval(p: dict, phi):
+def laurent_value(p: dict, phi):
     """L(exp(i phi)) as an acb, phi an arb ball."""
     from flint import acb
 
@@ -88,7 +90,7 @@ def _leval(p: dict, phi):
 
 
 @dataclass(frozen=True, eq=False)
-class _Reduction:
+class Reduction:
     """D, N and f as Laurent polynomials at one precision (z = B1 - A1 = N / D)."""
 
     D: dict
@@ -124,7 +126,7 @@ def _constants(geometry: Geometry, prec: int):
     return p, a, (q(a1x), q(a1y))
 
 
-def _reduce(geometry: Geometry, rho_sq) -> _Reduction:
+def reduction(geometry: Geometry, rho_sq) -> Reduction:
     """The reduced equation at the current precision (rho_sq: exact arb squares)."""
     from flint import acb, ctx
 
@@ -138,10 +140,10 @@ def _reduce(geometry: Geometry, rho_sq) -> _Reduction:
     f = _ladd(_lmul(N, _lconj(N)), _lscale(_lmul(D, D), acb(rho_sq[0])), -1)
     for kk in (4, -4):  # structurally absent (N has no omega^-2 term)
         f.pop(kk, None)
-    return _Reduction(D=D, N=N, f=f, a1=a1)
+    return Reduction(D=D, N=N, f=f, a1=a1)
 
 
-def _poly_t(red: _Reduction, phi0: float):
+def sextic_coefficients(red: Reduction, phi0: float):
     """Coefficients (arb, low to high) of P(t) = (1 + t^2)^3 f(phi0 + 2 atan t)."""
     from flint import acb, acb_poly, arb, ctx
 
@@ -156,7 +158,7 @@ def _poly_t(red: _Reduction, phi0: float):
     return [total[j].real for j in range(7)]
 
 
-def _choose_shift(red: _Reduction) -> tuple[float, object] | None:
+def choose_shift(red: Reduction) -> tuple[float, object] | None:
     """phi0 (a float, exact in arb) with f(phi0 + pi) PROVED non-zero, preferring 0."""
     from flint import arb
 
@@ -164,7 +166,7 @@ def _choose_shift(red: _Reduction) -> tuple[float, object] | None:
     best = None
     for j in range(12):
         phi0 = 0.0 if j == 0 else round(j * math.pi / 6, 6)
-        v = _leval(red.f, arb(phi0) + pi).real
+        v = laurent_value(red.f, arb(phi0) + pi).real
         if v.contains(0):
             continue
         lower = abs(float(v.mid()))
@@ -176,3 +178,4 @@ def _choose_shift(red: _Reduction) -> tuple[float, object] | None:
             if lower > 1e-3 * scale:
                 return best[0], best[1]
     return None if best is None else (best[0], best[1])
+

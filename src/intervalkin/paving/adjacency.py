@@ -1,28 +1,4 @@
-"""Octree pavings of the workspace domain: subdivision, tri-state labels, face adjacency.
-
-A paving is a set of axis-aligned boxes (x, y, phi) that tile a domain.  Each box
-is stored twice, consistently:
-
-* as integer coordinates ``(level, i, j, k)``: at ``level`` the domain is cut into
-  ``2**level`` slices per axis and the box is slice ``(i, j, k)``;
-* as float bounds ``lo``, ``hi`` of shape (n, 3), computed from the integers by one
-  formula (``lo = domain_lo + i * (width * 2**-level)``), so that two boxes that
-  share a face share it bit for bit, whatever their levels.
-
-Depth d means leaf width = domain width / 2**d on every axis.  Only undecided boxes
-are split, level by level, with numpy over all boxes of a level (no Python loop
-per box).
-
-Labels are ``uint8`` arrays of :class:`Label` flags: OUTSIDE = 1 (the predicate
-fails at every point of the box), INSIDE = 2 (it holds at every point),
-BOUNDARY = 3 (not decided).  ``a & b`` keeps the sharper of two sound labels of the
-same predicate; 0 would mean a contradiction, i.e. an unsound evaluation, and is
-asserted against.
-
-The phi axis is periodic.  The phi range of the domain is widened outward to
-[-PI_HI, PI_HI] (PI_HI is the float just above pi), so the boxes cover every angle
-and the two boxes on either side of the seam overlap (by ~1e-16) modulo 2 pi:
-their union is connected, which is what the seam adjacency claims.
+"""Face adjacency of the boxes of a paving, and connected components of labelled boxes.
 
 Face adjacency (``shares_face``): two boxes are adjacent when they share a 2-D
 piece of a face (a common edge or corner is not enough).  In an x-phi section

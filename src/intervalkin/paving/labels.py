@@ -1,49 +1,12 @@
-"""Octree pavings of the workspace domain: subdivision, tri-state labels, face adjacency.
+"""Tri-state labels of boxes as bit flags: OUTSIDE = 1, INSIDE = 2, BOUNDARY = 3.
 
-A paving is a set of axis-aligned boxes (x, y, phi) that tile a domain.  Each box
-is stored twice, consistently:
-
-* as integer coordinates ``(level, i, j, k)``: at ``level`` the domain is cut into
-  ``2**level`` slices per axis and the box is slice ``(i, j, k)``;
-* as float bounds ``lo``, ``hi`` of shape (n, 3), computed from the integers by one
-  formula (``lo = domain_lo + i * (width * 2**-level)``), so that two boxes that
-  share a face share it bit for bit, whatever their levels.
-
-Depth d means leaf width = domain width / 2**d on every axis.  Only undecided boxes
-are split, level by level, with numpy over all boxes of a level (no Python loop
-per box).
-
-Labels are ``uint8`` arrays of :class:`Label` flags: OUTSIDE = 1 (the predicate
-fails at every point of the box), INSIDE = 2 (it holds at every point),
-BOUNDARY = 3 (not decided).  ``a & b`` keeps the sharper of two sound labels of the
-same predicate; 0 would mean a contradiction, i.e. an unsound evaluation, and is
-asserted against.
-
-The phi axis is periodic.  The phi range of the domain is widened outward to
-[-PI_HI, PI_HI] (PI_HI is the float just above pi), so the boxes cover every angle
-and the two boxes on either side of the seam overlap (by ~1e-16) modulo 2 pi:
-their union is connected, which is what the seam adjacency claims.
-
-Face adjacency (``shares_face``): two boxes are adjacent when they share a 2-D
-piece of a face (a common edge or corner is not enough).  In an x-phi section
-(faces are drawn as edges)::
-
-      phi = +pi  +---------+----+----+      ^ phi
-                 |         | b  | c  |      |
-                 |    a    +----+----+      +--> x
-                 |         | d  | e  |
-                 +----+----+----+----+      a-b, a-d, a-f, a-g: share a face piece
-                 | f  | g  |         |      d-h, e-h, g-h, j-h: share a face piece
-                 +----+----+    h    |      a-h, d-g: a corner only, NOT adjacent
-                 | i  | j  |         |
-      phi = -pi  +----+----+---------+
-                 seam: phi = +pi is phi = -pi, so the top faces of a, b, c touch
-                 the bottom faces of i, j, h: a-i, a-j, b-h, c-h are adjacent too.
-
-All adjacency pairs are computed in bulk from the integer coordinates: along an
-axis, a "+" face and a "-" face on the same plane overlap in 2-D exactly when one
-dyadic square contains the other, so each face looks up its ancestors' keys
-(one sorted search per level).
+A label is the set of answers a sound evaluation still allows (bit 1: the predicate
+may fail somewhere in the box, bit 2: it may hold somewhere).  Two sound labels of
+the same predicate combine by ``&`` (keep what both allow; 0 would mean that two
+sound evaluations contradict each other, which is asserted against); children are
+merged into a parent by ``|``.  A conjunction of two DIFFERENT predicates is
+:func:`and_labels` (OUTSIDE if either fails everywhere, INSIDE only if both hold
+everywhere), and :func:`not_label` swaps INSIDE and OUTSIDE.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Octree pavings of the workspace domain: subdivision, tri-state labels, face adjacency.
+"""Octree pavings: boxes stored as integer coordinates, subdivided level by level where undecided.
 
 A paving is a set of axis-aligned boxes (x, y, phi) that tile a domain.  Each box
 is stored twice, consistently:
@@ -23,27 +23,6 @@ The phi axis is periodic.  The phi range of the domain is widened outward to
 [-PI_HI, PI_HI] (PI_HI is the float just above pi), so the boxes cover every angle
 and the two boxes on either side of the seam overlap (by ~1e-16) modulo 2 pi:
 their union is connected, which is what the seam adjacency claims.
-
-Face adjacency (``shares_face``): two boxes are adjacent when they share a 2-D
-piece of a face (a common edge or corner is not enough).  In an x-phi section
-(faces are drawn as edges)::
-
-      phi = +pi  +---------+----+----+      ^ phi
-                 |         | b  | c  |      |
-                 |    a    +----+----+      +--> x
-                 |         | d  | e  |
-                 +----+----+----+----+      a-b, a-d, a-f, a-g: share a face piece
-                 | f  | g  |         |      d-h, e-h, g-h, j-h: share a face piece
-                 +----+----+    h    |      a-h, d-g: a corner only, NOT adjacent
-                 | i  | j  |         |
-      phi = -pi  +----+----+---------+
-                 seam: phi = +pi is phi = -pi, so the top faces of a, b, c touch
-                 the bottom faces of i, j, h: a-i, a-j, b-h, c-h are adjacent too.
-
-All adjacency pairs are computed in bulk from the integer coordinates: along an
-axis, a "+" face and a "-" face on the same plane overlap in 2-D exactly when one
-dyadic square contains the other, so each face looks up its ancestors' keys
-(one sorted search per level).
 """
 
 from __future__ import annotations

@@ -286,8 +286,8 @@ def certify_start(geometry: Geometry, q: Interval, x: np.ndarray, radius: float 
 # --------------------------------------------------------------------------------------
 # Boxes compared modulo 2 pi in phi
 # --------------------------------------------------------------------------------------
-def _shift_phi(lo: np.ndarray, hi: np.ndarray, turns: np.ndarray):
-    """Enclosure of [lo, hi] + 2 pi turns in phi (turns integer array)."""
+def shift_phi_boxes(lo: np.ndarray, hi: np.ndarray, turns: np.ndarray):
+    """Boxes (lo, hi arrays (m, 3)) with phi moved by 2 pi turns (integer array (m,)), rounded outward."""
     two_pi = Interval(np.full(len(turns), 2 * PI_LO), np.full(len(turns), 2 * PI_HI)) * turns.astype(np.float64)
     ph = Interval(lo[:, 2], hi[:, 2]) + two_pi
     lo2, hi2 = lo.copy(), hi.copy()
@@ -306,7 +306,7 @@ def compare_mod_2pi(x_lo, x_hi, z_lo, z_hi):
     inside = np.zeros(len(k0), dtype=bool)
     apart = ((x_hi[:, 2] - x_lo[:, 2]) < 3.0) & ((z_hi[:, 2] - z_lo[:, 2]) < 3.0)
     for dk in (-1, 0, 1):
-        lo2, hi2 = _shift_phi(z_lo, z_hi, k0 + dk)
+        lo2, hi2 = shift_phi_boxes(z_lo, z_hi, k0 + dk)
         inside |= np.all((x_lo <= lo2) & (hi2 <= x_hi), axis=1)
         apart &= np.any((hi2 < x_lo) | (x_hi < lo2), axis=1)
     return inside, apart & ~inside

@@ -95,13 +95,14 @@ import numpy as np
 from flint import acb_poly, arb, ctx, fmpq
 
 from intervalkin.core.errors import InputError
+from intervalkin.core.exact import exact_text
 from intervalkin.core.geometry import Geometry
 from intervalkin.kinematics.sextic import (
-    _choose_shift,
-    _leval,
-    _poly_t,
-    _reduce,
-    _Reduction,
+    Reduction,
+    choose_shift,
+    laurent_value,
+    reduction,
+    sextic_coefficients,
 )
 from intervalkin.solve.krawczyk import box_bounds, disjoint_mod_2pi, krawczyk
 from intervalkin.solve.solutions import DkpResult, DkpSolution
@@ -146,7 +147,7 @@ def parse_joint_vector(geometry: Geometry, values: Sequence) -> tuple[Fraction, 
     for i, text in enumerate(values):
         leg = f"rho_{i + 1}"
         lo, hi = geometry.rho_min[i], geometry.rho_max[i]
-        allowed = f"[{_fmt_fraction(lo)}, {_fmt_fraction(hi)}]"
+        allowed = f"[{exact_text(lo)}, {exact_text(hi)}]"
         if isinstance(text, (Fraction, int)) and not isinstance(text, bool):
             v = Fraction(text)
         else:
@@ -163,14 +164,6 @@ def parse_joint_vector(geometry: Geometry, values: Sequence) -> tuple[Fraction, 
     return (out[0], out[1], out[2])
 
 
-def _fmt_fraction(q: Fraction) -> str:
-    """A limit for messages: the integer, or its decimal expansion (28 significant digits at most)."""
-    if q.denominator == 1:
-        return str(q.numerator)
-    d = Decimal(q.numerator) / Decimal(q.denominator)
-    return format(d.normalize(), "f")
-
-
 # --------------------------------------------------------------------------------------
 # One attempt at one precision
 # --------------------------------------------------------------------------------------
@@ -185,10 +178,10 @@ def _add_if_disjoint(sols: list, s: DkpSolution) -> None:
         sols.append(s)
 
 
-def _lift(red: _Reduction, pm) -> np.ndarray:
+def _lift(red: Reduction, pm) -> np.ndarray:
     """The float pose (x, y, phi) of the solution at the angle ``pm`` (an arb point): z = N / D."""
-    Nm = _leval(red.N, pm)
-    Dm = _leval(red.D, pm).real
+    Nm = laurent_value(red.N, pm)
+    Dm = laurent_value(red.D, pm).real
     x = red.a1[0] + Nm.real / Dm
     y = red.a1[1] + Nm.imag / Dm
     return np.array([float(x.mid()), float(y.mid()), math.remainder(float(pm.mid()), math.tau)])
@@ -203,13 +196,13 @@ class _Attempt:
 
 
 def _attempt(geometry: Geometry, rho, rho_sq, prec: int) -> _Attempt:
-    red = _reduce(geometry, rho_sq)
-    shift = _choose_shift(red)
+    red = reduction(geometry, rho_sq)
+    shift = choose_shift(red)
     if shift is None:
         return _Attempt([], False, "reduced equation f(phi) could not be proved non-zero at any trial angle "
                         "(it may vanish identically: architecturally singular manipulator)", [])
     phi0, _lead = shift
-    coeffs = _poly_t(red, phi0)
+    coeffs = sextic_coefficients(red, phi0)
     if coeffs[6].contains(0):  # the leading coefficient is f(phi0 + pi): must be proved non-zero
         return _Attempt([], False, f"leading coefficient of the reduced sextic not proved non-zero at {prec} bits",
                         _float_candidates(coeffs, phi0, red))
@@ -233,7 +226,7 @@ def _attempt(geometry: Geometry, rho, rho_sq, prec: int) -> _Attempt:
     starts = []
     for t in real_t:
         phi = arb(phi0) + 2 * t.atan()
-        if _leval(red.D, phi).real.contains(0):
+        if laurent_value(red.D, phi).real.contains(0):
             return _Attempt([], False, f"2x2 linear system may be singular at a root phi ~ {float(phi.mid()):.6g} "
                             f"of the reduced equation ({prec} bits)", _float_candidates(coeffs, phi0, red))
         starts.append(_lift(red, phi.mid()))
@@ -263,7 +256,7 @@ def _attempt(geometry: Geometry, rho, rho_sq, prec: int) -> _Attempt:
                     f"each, {len(sols)} disjoint Krawczyk boxes", [])
 
 
-def _float_candidates(coeffs, phi0: float, red: _Reduction) -> list:
+def _float_candidates(coeffs, phi0: float, red: Reduction) -> list:
     """Approximate solutions from the float roots of P (for the fallback only)."""
     c = np.array([float(v.mid()) for v in coeffs])[::-1]
     while len(c) > 1 and c[0] == 0.0:
@@ -275,7 +268,7 @@ def _float_candidates(coeffs, phi0: float, red: _Reduction) -> list:
         if abs(t.imag) > 1e-4 * (1.0 + abs(t)):
             continue
         pm = arb(phi0 + 2.0 * math.atan(t.real))
-        if _leval(red.D, pm).real.contains(0):
+        if laurent_value(red.D, pm).real.contains(0):
             continue
         out.append(_lift(red, pm))
     return out

@@ -1,1 +1,13 @@
-"""TODO"""
+"""space/: the paper's definition sets, built on certified pavings and solves.
+
+aspect                  components of W of one certified sign of det A
+singular_surface        the singular layer of the workspace and the image g(S)
+joint_space             joint cells off an outer enclosure of g(S) (voxel grid)
+joint_paving            joint space paved directly with the simple-roots test (adaptive)
+characteristic_surface  aspect boxes certified off S_c
+pieces, sheets, voxel_paths   pieces of certified boxes and the sheet above a cell each lies on
+basic_region            basic regions and basic components (Theorem 1, Proposition 1)
+uniqueness_domain       uniqueness domains (Theorem 2)
+pose_label              the certified labels of one exact pose
+segment, path_search, trajectory, trajectory_result   certified non-singular trajectories
+"""

@@ -35,7 +35,7 @@ from intervalkin.core.interval import PI_HI
 from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
-from intervalkin.solve.continuation import _shift_phi
+from intervalkin.solve.continuation import shift_phi_boxes
 from intervalkin.space.segment import certify_segment
 
 __all__ = ['metric_length', 'wrap_phi', 'path_distance', 'shortest_box_path', 'crossing_waypoints', 'goal_turns',
@@ -156,7 +156,7 @@ def shift_phi(box: np.ndarray, turns: int) -> np.ndarray:
     """The enclosure box (3, 2) with phi + 2 pi turns, rounded outward (the box itself for 0 turns)."""
     if turns == 0:
         return box.copy()
-    lo, hi = _shift_phi(box[None, :, 0], box[None, :, 1], np.array([turns]))
+    lo, hi = shift_phi_boxes(box[None, :, 0], box[None, :, 1], np.array([turns]))
     return np.stack([lo[0], hi[0]], axis=1)
 
 

@@ -85,12 +85,12 @@ def _endpoints(geometry: Geometry, rho, i_from: int, i_to: int):
     q = parse_joint_vector(geometry, list(rho))
     res = solve(geometry, q)
     n = len(res.solutions)
-    for name, i in (("--from", i_from), ("--to", i_to)):
+    for name, i in (("i_from", i_from), ("i_to", i_to)):
         if isinstance(i, bool) or not isinstance(i, (int, np.integer)) or not 1 <= i <= n:
             raise InputError(f"{name}: expected a solution number in 1..{n} for rho = "
                              f"{[float(v) for v in q]}, got {i!r}")
     if i_from == i_to:
-        raise InputError(f"--from and --to both name solution {i_from}: nothing to move")
+        raise InputError(f"i_from and i_to both name solution {i_from}: nothing to move")
     if not res.complete:
         raise InputError(f"rho = {[float(v) for v in q]}: the direct kinematics could not be certified "
                          f"({res.completeness_reason}), so solution numbers are not well defined")
