@@ -6,7 +6,7 @@ Independent checks used here:
   exact geometry (Fractions and surds), Newton from the box midpoint; the
   converged point must lie in the certified box with residual < 1e-40, and the
   sign of det A there must equal the certified sign.
-* :func:`intervalkin.solve.dkp.approx_solve`: float64 dense phi sampling (no arb, no
+* ``tests.approx.approx_solve``: float64 dense phi sampling (no arb, no
   polynomial), whose count must agree with the certified count.
 """
 

@@ -22,8 +22,8 @@ determine a quadratic exactly.  Each entry is then enclosed by two floats.
 
 What is certified: ``reduced_coefficients(geometry)`` returns float intervals
 that contain the exact entries of C.  The polarisation identity is exact for a
-polynomial of degree 2, and :func:`tests.kinematics` compares the form with the
-direct reduction at random r in arb.
+polynomial of degree 2, and ``tests/test_simple_roots.py`` compares the form
+with the direct reduction at random r and phi in arb.
 """
 
 from __future__ import annotations

@@ -37,10 +37,12 @@ Enclosures are mean-value forms about the centre (r_c, phi_m) of R^2 x Phi,
 
     f(R, Phi) in f(r_c, phi_m) + sum_i d_i f(R, Phi) (R_i - r_c,i) + d_phi f(R, Phi) (Phi - phi_m),
 
-with the gradient enclosed over the whole box (c_h(R), its r-derivatives and the
-phi-derivatives of the basis), all in outward-rounded interval arithmetic
-(:class:`intervalkin.core.interval.Interval`).  The same form with f replaced by
-df/dphi encloses the slope.  Work is vectorised over all (box, piece) pairs.
+where for fixed phi the quadratic in r is expanded exactly about r_c (the
+second-order part bounded once per box), intersected with the natural form in
+phi.  The arithmetic is midpoint-radius (:class:`intervalkin.core.ball.Ball`,
+proofs/lemma-ball-arithmetic.md): the work is small dot products over millions of
+(box, piece) pairs, vectorised with numpy.  The same form with f replaced by
+df/dphi encloses the slope.
 """
 
 from __future__ import annotations

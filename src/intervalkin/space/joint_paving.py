@@ -45,8 +45,9 @@ class JointSpaceCell:
     """A face-connected set of clear joint boxes, with its certified count.
 
     ``count``, ``n_wa1``, ``n_wa2``: from one complete certified solve at
-    ``witness`` (exact, the centre of one box of the cell); -1 if that solve
-    could not be completed (never expected off g(S)).  ``volume`` is the sum of
+    ``witness`` (exact, the centre of one box of the cell) in which the sign of
+    det A is proved for every solution; -1 if that could not be done (never
+    expected off g(S)).  ``volume`` is the sum of
     the box volumes (a float measure, not a certified bound).
     """
 
@@ -134,7 +135,7 @@ def pave_joint_space(geometry: Geometry, depth: int, progress: Callable[[dict], 
         best = members[np.argmin(paving.level[members])]  # the largest box: its centre is far from g(S)
         witness = _exact_centre(paving.lo[best], paving.hi[best])
         res = solve(geometry, witness)
-        if res.complete:
+        if res.complete and all(s.aspect in ("WA1", "WA2") for s in res.solutions):
             n1 = sum(1 for s in res.solutions if s.aspect == "WA1")
             count, n_wa1, n_wa2 = res.count, n1, res.count - n1
         else:
