@@ -20,7 +20,7 @@ gives one verdict per claim.  Its trusted base is small on purpose:
 It never imports the kinematics, paving, solver, space, certify or app code,
 nor numpy (the import-linter contract in ``pyproject.toml``,
 ``tests/test_architecture.py`` and
-``tests/test_certificates.py::test_checker_imports_none_of_the_checked_modules``).
+``tests/certify/test_certificates.py::test_checker_imports_none_of_the_checked_modules``).
 What each claim type proves, and what it still trusts, is in
 ``proofs/lemma-checker.md``.
 

@@ -4,7 +4,7 @@ These formulas exist twice in the package on purpose.  :mod:`intervalkin.kinemat
 is what the library computes with; this module is what the checker re-proves
 with, written out again from the mathematics (DESIGN.md sections 1-2) so that a
 slip in one is not silently shared by the other.  The tests compare the two
-(``tests/test_certificates.py::test_checker_det_formula_is_the_jacobian_determinant``,
+(``tests/certify/test_certificates.py::test_checker_det_formula_is_the_jacobian_determinant``,
 ``::test_reduced_sextic_agrees_with_the_solver_derivation``).
 
 Notation: B1 = (x, y), r_i = R(phi) p_i (r_1 = 0), u_i = B1 + r_i - A_i,

@@ -13,7 +13,7 @@ operands (the inclusion property), rounding errors included:
   ``|fl(cos t) - cos t| <= TRIG_ABS_ERROR`` (and the same for sin) for
   ``|t| <= TRIG_MAX_ARG``, a bound over 60 times the worst case observed (5.6e-17,
   a quarter of an ulp of 1) and checked against arb on many thousands of arguments by
-  ``tests/test_interval.py::test_trig_error_bound`` (proofs/lemma-trig-enclosure.md).
+  ``tests/core/test_interval.py::test_trig_error_bound`` (proofs/lemma-trig-enclosure.md).
   Whether an interval holds an extremum of cos or sin is decided with an
   enclosure [PI_LO, PI_HI] of pi, conservatively (a possible extremum is included).
   Outside [-TRIG_MAX_ARG, TRIG_MAX_ARG], or over a width of 2 pi or more, the
@@ -24,7 +24,7 @@ operands (the inclusion property), rounding errors included:
   layer, free of numpy), or :meth:`Interval.from_exact` for arrays of them.
 
 These two modules are the only places in the package that move a float by an ulp
-(proofs/lemma-outward-rounding.md); ``tests/test_rounding.py`` switches
+(proofs/lemma-outward-rounding.md); ``tests/core/test_interval_rounding.py`` switches
 :func:`round_down` and :func:`round_up` off and checks that the suite's soundness
 checks then fail.
 

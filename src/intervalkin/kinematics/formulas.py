@@ -74,7 +74,7 @@ def det_coefficients(r2x, r2y, r3x, r3y, e2x, e2y, e3x, e3y) -> tuple:
         a = r_2y D_3y - r_3y D_2y,      b = (r_3x D_2y - r_2x D_3y) - (r_2y D_3x - r_3y D_2x),
         c = r_2x D_3x - r_3x D_2x,      d = D_2y k_3 - k_2 D_3y,    e = k_2 D_3x - D_2x k_3.
 
-    ``tests/test_kinematics.py`` checks 8 Q against the determinant of A in arb.
+    ``tests/kinematics/test_enclosures.py`` checks 8 Q against the determinant of A in arb.
     """
     k2 = r2y * e2x - r2x * e2y
     k3 = r3y * e3x - r3x * e3y

@@ -22,7 +22,7 @@ determine a quadratic exactly.  Each entry is then enclosed by two floats.
 
 What is certified: ``reduced_coefficients(geometry)`` returns float intervals
 that contain the exact entries of C.  The polarisation identity is exact for a
-polynomial of degree 2, and ``tests/test_simple_roots.py`` compares the form
+polynomial of degree 2, and ``tests/solve/test_simple_roots.py`` compares the form
 with the direct reduction at random r and phi in arb.
 """
 

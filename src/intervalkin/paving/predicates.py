@@ -16,7 +16,7 @@ Certified: a label comes only from comparisons of outward-rounded enclosures
 :func:`~intervalkin.kinematics.enclosures.det_a_interval`, the phi-tight forms) with
 outward enclosures of the exact squared limits, never from a float value.  INSIDE
 means the predicate holds at every point of the box (closed box), OUTSIDE that it fails
-at every point; BOUNDARY claims nothing.  ``tests/test_predicate_properties.py``
+at every point; BOUNDARY claims nothing.  ``tests/paving/test_predicates_properties.py``
 samples points of labelled boxes and checks each label in arb.
 """
 

@@ -91,8 +91,8 @@ class _Boxes:
         f = c(r_c) . w + sum_i (d c / d r_i)(r_c) . w  d_i + sum_h w_h Q_h(d),
 
     w = basis(phi) and Q_h the quadratic part of c_h.  Over a piece Phi, w is a
-    ball; |d_i| <= h_i (the half-width of R_i^2) and |w_h| <= k_h^j for the j-th
-    phi-derivative bound the last sum once per box.
+    ball; the coefficients sum_h w_h Q_h of the monomials d_i d_j are computed per
+    piece, and |d_i| <= h_i (the half-width of R_i^2) bounds them.
     """
 
     def __init__(self, geometry: Geometry, boxes: np.ndarray):
@@ -117,15 +117,12 @@ class _Boxes:
         monos = _stack([_stack(row) for row in rows], axis=1)  # (n, 4, 10)
         Ct = Ball(C.mid.T.copy(), C.rad.T.copy())  # (10, 7)
         self.taylor = monos.matmul(Ct)  # (n, 4, 7): c(r_c) and its three r-derivatives
-        # second-order part: |sum_h w_h Q_h(d)| <= sum_m (sum_h k_h^j |C_hm|) |d-monomial_m|
+        # second-order part, sum_h w_h Q_h(d): the quadratic coefficients as rows (6, 7), d-bounds per box
+        quad = [m for m, e in enumerate(MONOMIALS) if len(e) == 2]
+        self.quad_rows = Ball(C.mid[:, quad].T.copy(), C.rad[:, quad].T.copy())  # (6, 7)
         h = self.half
-        dmono = np.zeros((n, 10))
-        for m, e in enumerate(MONOMIALS):
-            if len(e) == 2:
-                dmono[:, m] = h[:, e[0]] * h[:, e[1]]
-        orders = np.array([k for k, _ in HARMONICS], dtype=np.float64)
-        absC = np.abs(C.mid) + C.rad
-        self.second = [(dmono @ ((orders[:, None] ** j) * absC).T).sum(axis=1) * (1.0 + 2.0**-40) for j in range(3)]
+        self.quad_square = np.array([MONOMIALS[m][0] == MONOMIALS[m][1] for m in quad])
+        self.quad_bound = np.stack([h[:, MONOMIALS[m][0]] * h[:, MONOMIALS[m][1]] for m in quad], axis=1) * (1.0 + 2.0**-40)
 
     def enclosure(self, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray, deriv: int) -> Interval:
         """Enclosure of d^deriv f / dphi^deriv over (box owner, piece [lo, hi]).
@@ -137,16 +134,24 @@ class _Boxes:
         half = self.half[owner]
         piece = Ball.from_interval(Interval(lo, hi))
 
-        def over_r(w: Ball, j: int) -> Ball:
+        def over_r(w: Ball) -> Ball:
             t = Ball(w.mid[:, None, :], w.rad[:, None, :]).dot(taylor)  # (m, 4)
             spread = np.einsum("mi,mi->m", np.abs(t.mid[:, 1:]) + t.rad[:, 1:], half)
-            extra = (spread + self.second[j][owner]) * (1.0 + 2.0**-40) + 2.0**-1000
-            return Ball(t.mid[:, 0], t.rad[:, 0] + extra)
+            q = w.matmul(Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy()))  # (m, 6)
+            bound = self.quad_bound[owner]
+            # d_i^2 lies in [0, h_i^2]: q d_i^2 in q h^2 / 2 +- |q| h^2 / 2; d_i d_j in [-h_i h_j, h_i h_j]
+            sq = self.quad_square
+            centre = np.einsum("mk,mk->m", q.mid[:, sq], 0.5 * bound[:, sq])
+            second = (np.einsum("mk,mk->m", np.abs(q.mid[:, sq]) + 2.0 * q.rad[:, sq], 0.5 * bound[:, sq])
+                      + np.einsum("mk,mk->m", np.abs(q.mid[:, ~sq]) + q.rad[:, ~sq], bound[:, ~sq]))
+            mid = t.mid[:, 0] + centre
+            extra = (spread + second + 2.0**-40 * np.abs(centre)) * (1.0 + 2.0**-40) + 2.0**-1000
+            return Ball(mid, t.rad[:, 0] + extra)
 
-        at_mid = over_r(_basis(Ball.point(piece.mid), deriv), deriv)
-        slope = over_r(_basis(piece, deriv + 1), deriv + 1)
+        at_mid = over_r(_basis(Ball.point(piece.mid), deriv))
+        slope = over_r(_basis(piece, deriv + 1))
         mv = (at_mid + slope * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
-        natural = over_r(_basis(piece, deriv), deriv).to_interval()
+        natural = over_r(_basis(piece, deriv)).to_interval()
         return mv.intersect(natural)
 
 

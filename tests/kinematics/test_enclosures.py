@@ -35,7 +35,7 @@ from intervalkin.kinematics.formulas import (
 )
 from intervalkin.paving.predicates import pave_workspace
 
-from .conftest import DATA
+from ..conftest import DATA
 
 
 @pytest.fixture(autouse=True)

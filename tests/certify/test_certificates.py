@@ -23,12 +23,12 @@ from intervalkin.checker.solutions import reduced_sextic as _reduced_sextic
 from intervalkin.certify.writer import write_certificates
 from intervalkin.app.cli import main
 from intervalkin.kinematics.sextic import reduction, sextic_coefficients
-from .approx import approx_solve
+from ..approx import approx_solve
 from intervalkin.solve.dkp import parse_joint_vector, solve
 from intervalkin.core.geometry import load_geometry
 from intervalkin.space.trajectory import trajectory
 
-from .conftest import DATA, small_chain
+from ..conftest import DATA, small_chain
 
 TABLE1 = ["14.98", "15.38", "12.0"]
 

@@ -16,7 +16,7 @@ from intervalkin.solve.dkp import parse_joint_vector, solve
 from intervalkin.space.trajectory import NoPathError, trajectory
 from intervalkin.space.segment import certify_segment
 
-from .conftest import small_chain
+from ..conftest import small_chain
 
 RHO = ["14.98", "15.38", "12.0"]
 PAIRS = [(2, 3), (2, 6), (3, 6)]

@@ -28,7 +28,7 @@ from intervalkin.kinematics.sextic import laurent_value, reduction
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.simple_roots import clear_boxes
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 
 
 def _split(result) -> tuple[int, int, int]:

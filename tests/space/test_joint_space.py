@@ -14,7 +14,7 @@ from intervalkin.solve.dkp import solve
 from intervalkin.solve.dkp import parse_joint_vector
 from intervalkin.space.joint_space import _mark, _range_sum, _summed_area, joint_paving
 
-from .conftest import small_chain
+from ..conftest import small_chain
 
 
 def solution_count(geometry, rho, paving):

@@ -12,7 +12,7 @@ from intervalkin.app.cli import main
 from intervalkin.solve.dkp import MAX_WIDTH
 from intervalkin.app.table1 import TABLE1_ROWS, TABLE1_SAME_ASPECT, format_table1, table1_comparison
 
-from .test_dkp import check_certified
+from ..solve.test_dkp import check_certified
 
 
 @pytest.fixture(scope="module")

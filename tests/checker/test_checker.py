@@ -1,6 +1,6 @@
 """The independent checker itself (src/intervalkin/checker/): what it reads, its arb model, its proofs.
 
-The tamper tests in test_certificates.py change honest files and expect a refusal;
+The tamper tests in tests/certify/test_certificates.py change honest files and expect a refusal;
 this file tests the checker's parts one by one:
 
 * parsing: exact numbers (never a binary float for a joint vector), boxes, hex floats;
@@ -38,7 +38,7 @@ from intervalkin.core.geometry import load_geometry
 from intervalkin.kinematics.formulas import det_a_arb, jacobian_arb, residual_arb, rho_sq_arb
 from intervalkin.solve.dkp import solve
 
-from .conftest import DATA
+from ..conftest import DATA
 
 TABLE1 = (Fraction("14.98"), Fraction("15.38"), Fraction(12))
 #: Joint vectors of the paper's manipulator with 0, 2, 4 and 6 solutions (witnesses of certified cells).

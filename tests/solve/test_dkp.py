@@ -26,13 +26,13 @@ from hypothesis import strategies as st
 
 from intervalkin.app.cli import main
 from intervalkin.solve.dkp import MAX_WIDTH, DkpResult, parse_joint_vector, solve
-from .approx import approx_solve
+from ..approx import approx_solve
 from intervalkin.app.text import format_dkp_table
 from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry, load_geometry, parse_geometry
 from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
 
-from .conftest import DATA
+from ..conftest import DATA
 
 # ------------------------------------------------------------------------------------------
 # independent high-precision re-check

@@ -86,7 +86,7 @@ def test_solutions_of_random_joint_vectors_are_separated(chain, paper_geometry):
         res = solve(paper_geometry, q)
         assert res.complete
         regions, domains = [], []
-        # the leaf holding each solution box, or -1 (test_paving checks this lookup against brute force)
+        # the leaf holding each solution box, or -1 (paving/test_tree.py checks this lookup against brute force)
         holders = p.locate_boxes(np.array([s.box for s in res.solutions]))
         for s, i in zip(res.solutions, holders):
             if i >= 0 and ra.region[i] >= 0:

@@ -1,6 +1,6 @@
 """Hypothesis properties of the two remaining predicates: off the characteristic surfaces, and joint-cell counts.
 
-(W and the det A sign have theirs in test_predicates.py.)  Each property draws a
+(W and the det A sign have theirs in tests/paving/test_predicates.py.)  Each property draws a
 labelled box or voxel of the shared small chain (workspace depth 7, joint grid 2**6,
 regions depth 7) and a point in it, and re-derives the label without the paving:
 

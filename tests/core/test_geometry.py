@@ -11,7 +11,7 @@ from intervalkin.app.cli import main
 from intervalkin.core.errors import GeometryError
 from intervalkin.core.geometry import default_geometry, load_geometry
 
-from .conftest import DATA
+from ..conftest import DATA
 
 PAPER = """
 name = "test"

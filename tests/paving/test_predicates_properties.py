@@ -24,7 +24,7 @@ from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinemat
 from intervalkin.paving.labels import Label
 from intervalkin.paving.predicates import aspect_labels, aspect_predicate, det_sign_labels, workspace_labels
 
-from .conftest import DATA
+from ..conftest import DATA
 
 PREC = 256
 GEOMETRIES = {
