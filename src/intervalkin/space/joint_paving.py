@@ -18,6 +18,14 @@ What is NOT yet claimed: two cells are not proved to be different components of
 the joint box minus g(S) (they may join through the undecided boxes), and the
 undecided boxes may hide small cells.  Counting cells exactly is the subject of
 the certified local models (DESIGN.md section 8).
+
+Known limit of the predicate: where two solutions share one orientation phi*
+(phi* a zero of D, so the 2x2 position system is singular there, and N(phi*) = 0),
+f has a double root at phi* although nothing is singular.  For the paper's
+manipulator D vanishes at phi* = 0.0339 and 0.8834, and each condition
+N(phi*; r) = 0 is a plane in r = rho^2 that crosses the joint box: boxes across
+these planes stay undecided and split cells that are one true cell.  They need a
+second elimination (or joining by continuation) before cell counts mean anything.
 """
 
 from __future__ import annotations
