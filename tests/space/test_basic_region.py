@@ -22,6 +22,13 @@ def chain(regions_chain):
     return regions_chain
 
 
+
+def _random_point_of_cell(jp, cid, rng) -> tuple:
+    """An exact joint vector inside a random voxel of cell ``cid`` (same draws as before: voxel, then offsets)."""
+    vox = np.argwhere(jp.cell == cid)
+    v = vox[rng.integers(len(vox))]
+    return tuple(jp.rho_min[i] + (int(v[i]) + Fraction(int(rng.integers(1, 99)), 100)) * jp.step[i] for i in range(3))
+
 def test_region_boxes_hold_their_labels_in_arb(chain, paper_geometry):
     """Points of region boxes: det A has the aspect's sign, the legs are within limits, g(X) is in the cell."""
     jp, ra = chain
@@ -80,9 +87,7 @@ def test_solutions_of_random_joint_vectors_are_separated(chain, paper_geometry):
     labelled = 0
     for _ in range(200):
         cid = realized[rng.integers(len(realized))]
-        vox = np.argwhere(jp.cell == cid)
-        v = vox[rng.integers(len(vox))]
-        q = tuple(jp.rho_min[i] + (int(v[i]) + Fraction(int(rng.integers(1, 99)), 100)) * jp.step[i] for i in range(3))
+        q = _random_point_of_cell(jp, cid, rng)
         res = solve(paper_geometry, q)
         assert res.complete
         regions, domains = [], []
@@ -215,9 +220,7 @@ def test_sheets_of_pieces_match_the_solutions_of_their_cell(chain, paper_geometr
     multi = [r.cell for r in ra.regions if r.sheet >= 1]
     for _ in range(60):
         cid = multi[rng.integers(len(multi))]
-        vox = np.argwhere(jp.cell == cid)
-        v = vox[rng.integers(len(vox))]
-        q = tuple(jp.rho_min[i] + (int(v[i]) + Fraction(int(rng.integers(1, 99)), 100)) * jp.step[i] for i in range(3))
+        q = _random_point_of_cell(jp, cid, rng)
         res = solve(paper_geometry, q)
         assert res.complete
         for sign, name in ((1, "WA1"), (-1, "WA2")):
