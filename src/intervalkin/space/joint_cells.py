@@ -1,0 +1,148 @@
+"""Cells of the direct joint-space paving: components of clear boxes, each with a certified count.
+
+A *cell* is a face-connected component of the clear boxes of a joint paving (no
+axis wraps).  It is connected (proofs/lemma-face-adjacency-connected.md) and lies
+off g(S), so the number of direct-kinematic solutions and their split between the
+aspects are the same at all its points (proofs/lemma-constant-count-off-gS.md):
+one certified solve at an exact point of one of its boxes gives them.  The solve
+is done once per cell and remembered by the box it was done in, so refining the
+paving (joins) re-solves only cells that hold none of the boxes solved before; a
+cell that holds boxes of several earlier cells must find one signature in them
+(a disagreement would be a soundness bug, and is raised).
+
+The *walls* are the undecided boxes that touch two different cells with the same
+count and split: the only places where refining can join two cells.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+from intervalkin.core.geometry import Geometry
+from intervalkin.paving.adjacency import component_labels, shares_face
+from intervalkin.paving.labels import Label
+from intervalkin.paving.tree import Paving
+from intervalkin.solve.dkp import solve
+
+__all__ = ["JointSpaceCell", "CellSolver", "separating_boxes"]
+
+_NOWRAP = (False, False, False)
+
+
+@dataclass(frozen=True)
+class JointSpaceCell:
+    """A face-connected set of clear joint boxes, with its certified count.
+
+    ``count``, ``n_wa1``, ``n_wa2``: from one complete certified solve at
+    ``witness`` (exact, the centre of one box of the cell) in which the sign of
+    det A is proved for every solution; -1 if that could not be done (never
+    expected off g(S)).  ``volume`` is the sum of the box volumes (a float
+    measure, not a certified bound).
+    """
+
+    id: int
+    boxes: int
+    volume: float
+    count: int
+    n_wa1: int
+    n_wa2: int
+    witness: tuple[Fraction, Fraction, Fraction]
+
+    @property
+    def signature(self) -> tuple[int, int, int]:
+        return self.count, self.n_wa1, self.n_wa2
+
+    def to_json(self) -> dict:
+        return {"id": self.id, "boxes": self.boxes, "volume": self.volume, "count": self.count,
+                "n_wa1": self.n_wa1, "n_wa2": self.n_wa2, "witness": [str(v) for v in self.witness]}
+
+
+def _keys(level: np.ndarray, ijk: np.ndarray) -> np.ndarray:
+    """One int64 per box: its level and integer coordinates (levels <= 15, coordinates < 2**16)."""
+    ijk = np.asarray(ijk, dtype=np.int64)
+    return (np.asarray(level, dtype=np.int64) << 48) | (ijk[:, 0] << 32) | (ijk[:, 1] << 16) | ijk[:, 2]
+
+
+def _exact_centre(lo: np.ndarray, hi: np.ndarray) -> tuple[Fraction, Fraction, Fraction]:
+    c = [(Fraction(float(a)) + Fraction(float(b))) / 2 for a, b in zip(lo, hi)]
+    return c[0], c[1], c[2]
+
+
+class CellSolver:
+    """Labels the cells of successive joint pavings, solving each new cell once."""
+
+    def __init__(self, geometry: Geometry):
+        self.geometry = geometry
+        self._solved: dict[int, tuple[tuple[int, int, int], tuple[Fraction, Fraction, Fraction]]] = {}
+        self.edges: np.ndarray = np.zeros((2, 0), dtype=np.int64)
+
+    def _signature(self, lo: np.ndarray, hi: np.ndarray):
+        witness = _exact_centre(lo, hi)
+        res = solve(self.geometry, witness)
+        if res.complete and all(s.aspect in ("WA1", "WA2") for s in res.solutions):
+            n1 = sum(1 for s in res.solutions if s.aspect == "WA1")
+            return (res.count, n1, res.count - n1), witness
+        return (-1, -1, -1), witness
+
+    def label(self, paving: Paving, fine_depth: int) -> tuple[np.ndarray, list[JointSpaceCell]]:
+        """(cell id per box, -1 where undecided; the cells, largest first) of ``paving``."""
+        ok = paving.labels["clear"] == Label.INSIDE
+        self.edges = shares_face(paving.level, paving.ijk, fine_depth, periodic=_NOWRAP)
+        comp = component_labels(len(paving), self.edges, ok)
+        keys = _keys(paving.level, paving.ijk)
+        known = np.flatnonzero(ok & np.isin(keys, np.fromiter(self._solved, dtype=np.int64, count=len(self._solved))))
+        first: dict[int, int] = {}
+        for k in known:  # one earlier solve per component is enough; all must agree
+            c = int(comp[k])
+            if c in first:
+                if self._solved[int(keys[k])][0] != self._solved[int(keys[first[c]])][0]:
+                    raise AssertionError("two solved boxes of one joint cell have different counts (unsound)")
+            else:
+                first[c] = int(k)
+        vol = paving.volume()
+        ncomp = int(comp.max()) + 1 if ok.any() else 0
+        box_count = np.bincount(comp[ok], minlength=ncomp)
+        comp_vol = np.bincount(comp[ok], weights=vol[ok], minlength=ncomp)
+        order = np.argsort(-comp_vol, kind="stable")
+        new_id = np.empty(ncomp, dtype=np.int64)
+        new_id[order] = np.arange(ncomp)
+        # the largest box of each component: its centre is farthest from g(S)
+        big = np.full(ncomp, -1)
+        idx = np.flatnonzero(ok)
+        by_size = idx[np.lexsort((idx, paving.level[idx]))]
+        big[comp[by_size[::-1]]] = by_size[::-1]
+        cells = []
+        for c in order:
+            c = int(c)
+            if c in first:
+                sig, witness = self._solved[int(keys[first[c]])]
+            else:
+                b = int(big[c])
+                sig, witness = self._signature(paving.lo[b], paving.hi[b])
+                self._solved[int(keys[b])] = (sig, witness)
+            cells.append(JointSpaceCell(int(new_id[c]), int(box_count[c]), float(comp_vol[c]), *sig, witness))
+        cell = np.where(ok, new_id[np.maximum(comp, 0)], -1).astype(np.int32)
+        return cell, cells
+
+
+def separating_boxes(edges: np.ndarray, cell: np.ndarray, cells: list[JointSpaceCell]) -> np.ndarray:
+    """(n,) bool: the undecided boxes that touch two different cells with the same known signature."""
+    n = len(cell)
+    a, b = edges
+    both = np.concatenate([np.stack([a, b]), np.stack([b, a])], axis=1)
+    u, v = both
+    sel = (cell[u] < 0) & (cell[v] >= 0)
+    u, c = u[sel], cell[v[sel]]
+    if u.size == 0:
+        return np.zeros(n, dtype=bool)
+    sigs = {}
+    sig_id = np.array([sigs.setdefault(x.signature, len(sigs)) if x.count >= 0 else -1 - x.id for x in
+                       sorted(cells, key=lambda x: x.id)], dtype=np.int64)
+    pairs = np.unique(np.stack([u, sig_id[c], c], axis=1), axis=0)  # sorted by (box, signature, cell)
+    same = (pairs[1:, 0] == pairs[:-1, 0]) & (pairs[1:, 1] == pairs[:-1, 1]) & (pairs[1:, 2] != pairs[:-1, 2])
+    out = np.zeros(n, dtype=bool)
+    out[pairs[1:, 0][same]] = True
+    return out
