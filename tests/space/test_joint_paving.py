@@ -5,7 +5,9 @@
   component would show as a different count;
 - cells are unions of face-adjacent clear boxes: components recomputed with
   networkx from a brute-force adjacency agree;
-- the boxes tile the joint box; the npz columns have the documented shapes.
+- the boxes tile the joint box; the npz columns have the documented shapes;
+- joining paths run through undecided boxes between cells of one signature only;
+- the large cells and their certified counts are the same at two depths.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import pytest
 from intervalkin.paving.adjacency import shares_face_bruteforce
 from intervalkin.paving.labels import Label
 from intervalkin.solve.dkp import solve
+from intervalkin.space.joint_cells import JointSpaceCell, joining_paths
 from intervalkin.space.joint_paving import joint_domain, pave_joint_space
 
 
@@ -68,3 +71,38 @@ def test_boxes_tile_the_joint_box(joint4, paper_geometry):
     n = len(joint4.paving)
     assert cols["lo"].shape == (n, 3) and cols["cell"].shape == (n,)
     assert set(np.unique(cols["count"][cols["cell"] < 0])) == {-1}
+
+
+def _cell(i: int, sig: tuple[int, int, int]) -> JointSpaceCell:
+    return JointSpaceCell(i, 1, 1.0, *sig, (Fraction(0), Fraction(0), Fraction(0)))
+
+
+def test_joining_paths_follow_undecided_chains_between_equal_cells():
+    # a row of boxes: cell 0 | three undecided | cell 1 | cell 2, with a side branch 6-7 off box 2
+    cell = np.array([0, -1, -1, -1, 1, 2, -1, -1])
+    edges = np.array([[0, 1, 2, 3, 4, 2, 6], [1, 2, 3, 4, 5, 6, 7]])
+    same = joining_paths(edges, cell, [_cell(0, (4, 2, 2)), _cell(1, (4, 2, 2)), _cell(2, (6, 3, 3))])
+    assert same.tolist() == [False, True, True, True, False, False, False, False]
+    other = joining_paths(edges, cell, [_cell(0, (4, 2, 2)), _cell(1, (2, 1, 1)), _cell(2, (6, 3, 3))])
+    assert not other.any()
+
+
+def test_large_cells_are_the_same_one_level_finer(paper_geometry):
+    """Cells holding >= 1 % of the joint box: the same certified signatures at depths 5 and 6.
+
+    Smaller cells are not compared: slivers along the faces rho_i = 10 appear as the
+    boxes get thinner (proofs and closing note of issue 13: the count is not yet exact).
+    """
+    coarse, finer = pave_joint_space(paper_geometry, 5), pave_joint_space(paper_geometry, 6)
+    total = float(np.prod(np.diff(joint_domain(paper_geometry), axis=1)))
+
+    def big(jp):
+        return sorted(c.signature for c in jp.cells if c.volume >= 0.01 * total)
+
+    assert big(coarse) == big(finer)
+    assert len(big(finer)) >= 4
+    # each large cell of the coarser paving lies inside a cell of the finer one with the same signature
+    for c in coarse.cells:
+        if c.volume >= 0.01 * total:
+            cid = finer.cell_of(np.array([[float(v) for v in c.witness]]))[0]
+            assert cid >= 0 and finer.cells[[x.id for x in finer.cells].index(cid)].signature == c.signature

@@ -10,8 +10,8 @@ paving (joins) re-solves only cells that hold none of the boxes solved before; a
 cell that holds boxes of several earlier cells must find one signature in them
 (a disagreement would be a soundness bug, and is raised).
 
-The *walls* are the undecided boxes that touch two different cells with the same
-count and split: the only places where refining can join two cells.
+The *joining paths* are shortest chains of undecided boxes between two cells
+with the same count and split: the places where refining can join two cells.
 """
 
 from __future__ import annotations
@@ -20,6 +20,8 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import breadth_first_order
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.paving.adjacency import component_labels, shares_face
@@ -27,9 +29,11 @@ from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 from intervalkin.solve.dkp import solve
 
-__all__ = ["JointSpaceCell", "CellSolver", "separating_boxes"]
+__all__ = ["JointSpaceCell", "CellSolver", "joining_paths"]
 
 _NOWRAP = (False, False, False)
+#: Boxes of a cell tried, largest first, before its count is left unknown (-1).
+_TRIES = 4
 
 
 @dataclass(frozen=True)
@@ -109,40 +113,64 @@ class CellSolver:
         order = np.argsort(-comp_vol, kind="stable")
         new_id = np.empty(ncomp, dtype=np.int64)
         new_id[order] = np.arange(ncomp)
-        # the largest box of each component: its centre is farthest from g(S)
-        big = np.full(ncomp, -1)
+        # the largest boxes of each component first: their centres are farthest from g(S)
         idx = np.flatnonzero(ok)
-        by_size = idx[np.lexsort((idx, paving.level[idx]))]
-        big[comp[by_size[::-1]]] = by_size[::-1]
+        by_size = idx[np.lexsort((idx, paving.level[idx], comp[idx]))]
+        start = np.searchsorted(comp[by_size], np.arange(ncomp))
         cells = []
         for c in order:
             c = int(c)
             if c in first:
                 sig, witness = self._solved[int(keys[first[c]])]
             else:
-                b = int(big[c])
-                sig, witness = self._signature(paving.lo[b], paving.hi[b])
-                self._solved[int(keys[b])] = (sig, witness)
+                tries = by_size[start[c]:start[c] + min(_TRIES, int(box_count[c]))]
+                for b in tries:
+                    sig, witness = self._signature(paving.lo[b], paving.hi[b])
+                    if sig[0] >= 0:
+                        self._solved[int(keys[b])] = (sig, witness)  # only proved signatures are reused
+                        break
             cells.append(JointSpaceCell(int(new_id[c]), int(box_count[c]), float(comp_vol[c]), *sig, witness))
         cell = np.where(ok, new_id[np.maximum(comp, 0)], -1).astype(np.int32)
         return cell, cells
 
 
-def separating_boxes(edges: np.ndarray, cell: np.ndarray, cells: list[JointSpaceCell]) -> np.ndarray:
-    """(n,) bool: the undecided boxes that touch two different cells with the same known signature."""
+def joining_paths(edges: np.ndarray, cell: np.ndarray, cells: list[JointSpaceCell]) -> np.ndarray:
+    """(n,) bool: the undecided boxes on a shortest chain of undecided boxes between two cells of one signature.
+
+    For each signature (count, n_wa1, n_wa2) held by several cells, a breadth-first
+    search from each cell (contracted to one node) through undecided boxes reaches the
+    other cells of that signature; the boxes of the shortest chains are returned.  They
+    are where refining can join two cells: a chain of one box is a wall between them,
+    a longer chain follows a thin layer (a slab along a face of the joint box) that
+    the current boxes are too coarse to certify.  Chains through cells of another
+    signature are not searched (such cells are certainly different components).
+    """
     n = len(cell)
-    a, b = edges
-    both = np.concatenate([np.stack([a, b]), np.stack([b, a])], axis=1)
-    u, v = both
-    sel = (cell[u] < 0) & (cell[v] >= 0)
-    u, c = u[sel], cell[v[sel]]
-    if u.size == 0:
-        return np.zeros(n, dtype=bool)
-    sigs = {}
-    sig_id = np.array([sigs.setdefault(x.signature, len(sigs)) if x.count >= 0 else -1 - x.id for x in
-                       sorted(cells, key=lambda x: x.id)], dtype=np.int64)
-    pairs = np.unique(np.stack([u, sig_id[c], c], axis=1), axis=0)  # sorted by (box, signature, cell)
-    same = (pairs[1:, 0] == pairs[:-1, 0]) & (pairs[1:, 1] == pairs[:-1, 1]) & (pairs[1:, 2] != pairs[:-1, 2])
     out = np.zeros(n, dtype=bool)
-    out[pairs[1:, 0][same]] = True
+    groups: dict[tuple[int, int, int], list[int]] = {}
+    for c in cells:
+        if c.count >= 0:
+            groups.setdefault(c.signature, []).append(c.id)
+    groups = {k: v for k, v in groups.items() if len(v) > 1}
+    if not groups:
+        return out
+    undecided = cell < 0
+    a, b = edges
+    for ids in groups.values():
+        member = np.zeros(len(cells), dtype=bool)
+        member[ids] = True
+        # nodes: the undecided boxes keep their index; the boxes of cell c become node n + c
+        node = np.where(undecided, np.arange(n), np.where(cell >= 0, n + np.maximum(cell, 0), -1))
+        usable = undecided | ((cell >= 0) & member[np.maximum(cell, 0)])
+        keep = usable[a] & usable[b] & (undecided[a] | undecided[b])
+        u, v = node[a[keep]], node[b[keep]]
+        graph = csr_matrix((np.ones(u.size), (u, v)), shape=(n + len(cells), n + len(cells)))
+        for k, src in enumerate(ids[:-1]):
+            _, pred = breadth_first_order(graph, n + src, directed=False, return_predecessors=True)
+            for dst in ids[k + 1:]:
+                at = pred[n + dst]
+                while at >= 0 and at != n + src:
+                    if at < n:
+                        out[at] = True
+                    at = pred[at]
     return out

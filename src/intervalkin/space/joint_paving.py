@@ -41,7 +41,7 @@ from intervalkin.paving.budget import check_depth
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving, box_bounds, split_boxes
 from intervalkin.solve.joint_box import initial_cells, live_cells
-from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, separating_boxes
+from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
 
 __all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain", "DEFAULT_JOINT_DEPTH", "JOIN_LEVELS"]
 
@@ -73,6 +73,14 @@ class JointSpacePaving:
     def certified_share(self) -> float:
         v = self.paving.volume()
         return float(v[self.cell >= 0].sum() / v.sum())
+
+    def cell_of(self, rho: np.ndarray) -> np.ndarray:
+        """Cell id (m,) of each joint box or point rho (m, 3, 2) or (m, 3): the cell of the leaf that
+        contains it entirely, -1 when that leaf is undecided or no single leaf contains it."""
+        q = np.asarray(rho, dtype=np.float64)
+        boxes = np.stack([q, q], axis=-1) if q.ndim == 2 else q
+        leaf = self.paving.locate_boxes(boxes)
+        return np.where(leaf >= 0, self.cell[np.maximum(leaf, 0)], -1)
 
     def columns(self) -> dict[str, np.ndarray]:
         """npz columns: lo, hi, level, cell id, count, n_wa1, n_wa2 (-1 where undecided)."""
@@ -143,33 +151,35 @@ class _Leaves:
 
 
 def _adaptive(geometry: Geometry, domain: np.ndarray, depth: int,
-              progress: Callable[[dict], None] | None) -> _Leaves:
+              progress: Callable[[dict], None] | None) -> tuple[_Leaves, list[dict]]:
     """Bisect the joint box, keeping clear boxes and splitting the others, down to ``depth``."""
     owner, cells = initial_cells(1)
     front = _Front(np.zeros(1, dtype=np.int64), np.zeros((1, 3), dtype=np.int64), owner, cells)
     leaves = _Leaves()
+    stats: list[dict] = []
     dom_vol = float(np.prod(domain[:, 1] - domain[:, 0]))
     for lev in range(depth + 1):
         t0 = time.perf_counter()
         lo, hi, clear, front = _test(geometry, domain, front)
         cut = ~clear if lev < depth else np.zeros(len(clear), dtype=bool)
         leaves.add(front, lo, hi, clear, ~cut)
-        if progress is not None:
-            progress({"stage": "joint paving", "level": lev, "depth": depth, "boxes": int(len(clear)),
+        stats.append({"stage": "joint paving", "level": lev, "depth": depth, "boxes": int(len(clear)),
                       "split": int(np.count_nonzero(cut)), "live_cells": int(front.owner.size),
                       "seconds": time.perf_counter() - t0,
                       "undecided_volume": {"clear": dom_vol * 8.0 ** (-lev) * int(np.count_nonzero(~clear))}})
+        if progress is not None:
+            progress(stats[-1])
         if not np.any(cut):
             break
         front = _children(front, cut)
-    return leaves
+    return leaves, stats
 
 
-def _to_paving(domain: np.ndarray, leaves: tuple[np.ndarray, ...]) -> Paving:
+def _to_paving(domain: np.ndarray, leaves: tuple[np.ndarray, ...], stats: list[dict]) -> Paving:
     level, ijk, lo, hi, clear = leaves[:5]
     lab = np.where(clear, Label.INSIDE, Label.BOUNDARY).astype(np.uint8)
     return Paving(domain=domain, depth=int(level.max()), level=level.astype(np.int8), ijk=ijk, lo=lo, hi=hi,
-                  labels={"clear": lab})
+                  labels={"clear": lab}, stats=stats)
 
 
 def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_levels: int = JOIN_LEVELS,
@@ -190,14 +200,15 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     if isinstance(join_levels, bool) or not isinstance(join_levels, int) or not 0 <= join_levels <= 4:
         raise InputError(f"join_levels: expected an integer in 0..4, got {join_levels!r}")
     domain = joint_domain(geometry)
-    leaves = _adaptive(geometry, domain, depth, progress).merge()
+    found_leaves, stats = _adaptive(geometry, domain, depth, progress)
+    leaves = found_leaves.merge()
     cells = CellSolver(geometry)
     for extra in range(join_levels + 1):
-        paving = _to_paving(domain, leaves)
+        paving = _to_paving(domain, leaves, stats)
         cell, found = cells.label(paving, depth + join_levels)
         if extra == join_levels:
             break
-        wall = separating_boxes(cells.edges, cell, found) & (paving.level < depth + join_levels)
+        wall = joining_paths(cells.edges, cell, found) & (paving.level < depth + join_levels)
         if progress is not None:
             progress({"stage": "joins", "level": depth + extra + 1, "depth": depth + join_levels,
                       "boxes": int(np.count_nonzero(wall)), "cells": len(found)})
