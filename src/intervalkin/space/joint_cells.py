@@ -18,18 +18,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import Sequence
 
 import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import breadth_first_order
 
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.status import Count
 from intervalkin.paving.adjacency import component_labels, shares_face
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 from intervalkin.solve.dkp import solve
 
-__all__ = ["JointSpaceCell", "CellSolver", "joining_paths"]
+__all__ = ["JointSpaceCell", "CellSolver", "joining_paths", "regions_from_cells"]
 
 _NOWRAP = (False, False, False)
 #: Boxes of a cell tried, largest first, before its count is left unknown (-1).
@@ -130,7 +132,8 @@ class CellSolver:
                         self._solved[int(keys[b])] = (sig, witness)  # only proved signatures are reused
                         break
             cells.append(JointSpaceCell(int(new_id[c]), int(box_count[c]), float(comp_vol[c]), *sig, witness))
-        cell = np.where(ok, new_id[np.maximum(comp, 0)], -1).astype(np.int32)
+        cell = np.full(len(paving), -1, dtype=np.int32)
+        cell[ok] = new_id[comp[ok]]
         return cell, cells
 
 
@@ -173,4 +176,40 @@ def joining_paths(edges: np.ndarray, cell: np.ndarray, cells: list[JointSpaceCel
                     if at < n:
                         out[at] = True
                     at = pred[at]
+    return out
+
+
+def regions_from_cells(cells: Sequence[JointSpaceCell], proved_lower: int = 0) -> Count:
+    """The basic regions implied by the joint cells (Theorem 1), as a :class:`Count`.
+
+    Above a component C of (joint box minus g(S)) whose points have n_wa1 + n_wa2
+    solutions, each aspect holds exactly that many basic regions (Theorem 1 and
+    Proposition 1 of the paper; proofs/lemma-theorem1-distinctness.md).  The count
+    found is the sum of the cells' counts, over EVERY cell, whether or not a
+    workspace box lands in it.  Proved: cells of different signatures lie in
+    different components, so the sum over the distinct signatures is a lower bound
+    (raised to ``proved_lower`` when another argument proves more).  Not proved: that
+    two cells of one signature are different components, or that no cell is hidden
+    in the undecided boxes; no upper bound.
+    """
+    known = [c for c in cells if c.count >= 0]
+    found = sum(c.count for c in known)
+    distinct = sum(sig[0] for sig in {c.signature for c in known})
+    lower = max(distinct, proved_lower)
+    unknown = len(cells) - len(known)
+    tally = ", ".join(f"{n} with {k}" for k, n in sorted(_tally(known).items())) or "none"
+    return Count(
+        max(found, lower), lower, None, False,
+        f"the sum of the certified solution counts of the {len(known)} cells of the direct joint paving "
+        f"(cells by solutions: {tally}); at least {lower} are "
+        "proved: cells of different count or aspect split are different components of the joint box minus "
+        "g(S), each carrying its count of basic regions; two cells of one signature may still be one component "
+        "joined through undecided boxes, and small cells may hide in them, so no upper bound is proved"
+        + (f"; {unknown} cells whose solve did not complete are not counted" if unknown else ""))
+
+
+def _tally(cells: Sequence[JointSpaceCell]) -> dict[int, int]:
+    out: dict[int, int] = {}
+    for c in cells:
+        out[c.count] = out.get(c.count, 0) + 1
     return out

@@ -197,8 +197,8 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     like 4**depth; each cell costs one certified solve.
     """
     check_depth(depth)
-    if isinstance(join_levels, bool) or not isinstance(join_levels, int) or not 0 <= join_levels <= 4:
-        raise InputError(f"join_levels: expected an integer in 0..4, got {join_levels!r}")
+    if isinstance(join_levels, bool) or not isinstance(join_levels, int) or not 0 <= join_levels <= 8:
+        raise InputError(f"join_levels: expected an integer in 0..8, got {join_levels!r}")
     domain = joint_domain(geometry)
     found_leaves, stats = _adaptive(geometry, domain, depth, progress)
     leaves = found_leaves.merge()
@@ -211,7 +211,7 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         wall = joining_paths(cells.edges, cell, found) & (paving.level < depth + join_levels)
         if progress is not None:
             progress({"stage": "joins", "level": depth + extra + 1, "depth": depth + join_levels,
-                      "boxes": int(np.count_nonzero(wall)), "cells": len(found)})
+                      "boxes": int(np.count_nonzero(wall)), "split": int(np.count_nonzero(wall)), "cells": len(found)})
         if not np.any(wall):
             break
         leaves = _refine(geometry, domain, leaves, wall)
