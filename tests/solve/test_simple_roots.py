@@ -26,7 +26,7 @@ from intervalkin.core.interval import Interval
 from intervalkin.kinematics.reduced_equation import HARMONICS, MONOMIALS, reduced_equation
 from intervalkin.kinematics.sextic import laurent_value, reduction
 from intervalkin.solve.dkp import solve
-from intervalkin.solve.joint_box import clear_boxes
+from intervalkin.solve.simple_roots import initial_pieces, open_pieces
 
 DATA = Path(__file__).parents[1] / "data"
 
@@ -94,6 +94,13 @@ def test_ball_from_interval_contains_the_interval():
     iv = Interval(np.array([1.0, -3.0, 0.1]), np.array([1.0 + 2**-30, 5.0, 0.3]))
     b = Ball.from_interval(iv).to_interval()
     assert np.all(b.lo <= iv.lo) and np.all(b.hi >= iv.hi)
+
+
+def clear_boxes(geometry, boxes: np.ndarray) -> np.ndarray:
+    """The simple-roots test alone: True where no piece of the orientation circle is left open."""
+    boxes = np.asarray(boxes, dtype=np.float64)
+    owner, _, _ = open_pieces(geometry, boxes, *initial_pieces(len(boxes)))
+    return np.bincount(owner, minlength=len(boxes)) == 0
 
 
 def _boxes(lo: np.ndarray, width: float) -> np.ndarray:
