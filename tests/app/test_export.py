@@ -1,20 +1,19 @@
-"""npz / JSON / VTK writers: documented columns, round trips, atomic replacement."""
+"""npz and JSON files: the documented columns (a contract), round trips, atomic replacement."""
 
 from __future__ import annotations
 
 import json
 import os
-import re
 
 import numpy as np
 import pytest
 
-from intervalkin.app.export import NPZ_COLUMNS, paving_columns, read_npz, read_vtu, write_npz, write_vtk_legacy, write_vtu
+from intervalkin.app.export import NPZ_COLUMNS, paving_columns, read_npz, write_npz
 from intervalkin.core.files import write_json
 from intervalkin.core.geometry import default_geometry
 from intervalkin.paving.labels import Label
-from intervalkin.space.aspect import aspect_components
 from intervalkin.paving.predicates import pave_workspace
+from intervalkin.space.aspect import aspect_components
 
 
 @pytest.fixture(scope="module")
@@ -59,33 +58,6 @@ def test_extra_column_checked(paving4):
         paving_columns(p, None, {"aspect": np.zeros(len(p))})
 
 
-def test_vtu_parses_and_counts_cells(tmp_path, paving4):
-    p, aspect = paving4
-    cols = paving_columns(p, aspect)
-    path = write_vtu(tmp_path / "w.vtu", p.lo, p.hi, {k: cols[k] for k in ("in_workspace", "det_sign", "aspect")})
-    g = read_vtu(path)
-    n = len(p)
-    assert g["NumberOfCells"] == n and g["NumberOfPoints"] == 8 * n
-    assert g["types"].shape == (n,) and np.all(g["types"] == 12)
-    assert np.array_equal(g["offsets"], 8 * np.arange(1, n + 1))
-    assert np.array_equal(g["aspect"], aspect)
-    pts = g["points"].reshape(n, 8, 3)
-    assert np.array_equal(pts.min(1), p.lo) and np.array_equal(pts.max(1), p.hi)
-
-
-def test_vtk_legacy_parses(tmp_path, paving4):
-    p, aspect = paving4
-    sel = slice(0, 50)
-    path = write_vtk_legacy(tmp_path / "w.vtk", p.lo[sel], p.hi[sel], {"aspect": aspect[sel]})
-    text = path.read_text()
-    assert text.startswith("# vtk DataFile Version 3.0")
-    m = re.search(r"CELLS (\d+) (\d+)", text)
-    assert int(m.group(1)) == 50 and int(m.group(2)) == 450
-    types = text.split("CELL_TYPES 50\n")[1].split("CELL_DATA")[0].split()
-    assert types == ["12"] * 50
-    assert int(re.search(r"POINTS (\d+)", text).group(1)) == 400
-
-
 def test_json_atomic(tmp_path):
     path = tmp_path / "summary.json"
     path.write_text("old")
@@ -95,21 +67,3 @@ def test_json_atomic(tmp_path):
         write_json(path, {"a": float("nan")})
     assert json.loads(path.read_text()) == {"a": 1, "b": [1.5, 2]}  # failed write left the old file
     assert os.listdir(tmp_path) == ["summary.json"]
-
-
-def test_vtu_with_shared_points(tmp_path):
-    """Shared corners: fewer points than 8 per box, every cell's corners are its box's corners."""
-    from intervalkin.app.export import write_vtu_paving
-
-    g = default_geometry()
-    p = pave_workspace(g, 4)
-    mask = p.labels["W"] != Label.OUTSIDE
-    path = write_vtu_paving(tmp_path / "s.vtu", p, {"depth": p.level}, mask=mask)
-    v = read_vtu(path)
-    n = int(mask.sum())
-    assert v["NumberOfCells"] == n and v["NumberOfPoints"] < 8 * n
-    conn = v["connectivity"].reshape(n, 8)
-    pts = v["points"][conn]
-    sel = np.flatnonzero(mask)
-    assert np.array_equal(pts.min(axis=1), p.lo[sel]) and np.array_equal(pts.max(axis=1), p.hi[sel])
-    assert np.array_equal(v["depth"], p.level[sel])

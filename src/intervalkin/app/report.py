@@ -5,8 +5,11 @@ of them in one aspect; two aspects; joint-space domains with 2, 4 and 6
 solutions; 28 basic regions; 6 uniqueness domains; non-singular paths between
 solutions 2, 3 and 6.  The report sets each claim beside what the run
 certified, with its status (certified, or a certified lower bound and why no
-more is proved), the figures, and the undecided volumes and timings.  It only
-formats: every number comes from the analysis and its summary.json.
+more is proved), the figures (one passage per octree figure of the paper, from
+:mod:`intervalkin.app.report_figures`), and the undecided volumes and timings.  It
+only formats: every number comes from the analysis and its summary.json.
+:mod:`intervalkin.app.report_html` turns the same text into ``report.html``, with
+rotatable 3-D views.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from intervalkin.app.report_figures import figure_passage, figures_table
 from intervalkin.app.table1 import table1_comparison
 from intervalkin.core.files import atomic_write_bytes
 from intervalkin.pipeline import Analysis
@@ -27,11 +31,6 @@ def _status(block: dict) -> str:
     if block.get("exact"):
         return "certified exact"
     return f"found {block['count']}; certified lower bound {block['lower_bound']}"
-
-
-def _fig(name: str, caption: str, files: list[str]) -> str:
-    path = f"figures/{name}"
-    return f"![{caption}]({path})\n\n*{caption}*\n" if path in files else f"*(figure {name} not written)*\n"
 
 
 def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
@@ -52,6 +51,11 @@ def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
       "is exact or a lower bound, and why. `certificates/` holds the evidence; `intervalkin verify "
       "certificates` re-checks it with arb alone.\n")
 
+    a("## The paper's figures, redrawn\n")
+    a("Each octree figure of the paper is redrawn from certified labels; its passage below gives the numbers "
+      "behind it. Colours are the same in every figure (one per basic region, per uniqueness domain, per "
+      "solution count); phi is in degrees.\n")
+    a(figures_table(files))
     a("## Summary of the claims\n")
     a("| paper's claim | computed | status |")
     a("|---|---|---|")
@@ -98,10 +102,8 @@ def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
       + " of volume, the others are small fragments cut off by the undecided layer. Two aspects are "
       "certified different (opposite det A signs): a lower bound of 2. That no third aspect hides in the "
       "undecided layer is not proved.\n")
-    a(_fig("workspace_3d.png", "Workspace W (cf. Fig. 3)", files))
-    a(_fig("singular_3d.png", "Type-2 singular layer (cf. Fig. 5)", files))
-    a(_fig("aspects_3d.png", "The two aspects (cf. Fig. 6)", files))
-    a(_fig("aspects_slices.png", "Aspects and singular layer, phi-slices", files))
+    for number in (3, 5, 6):
+        a(figure_passage(number, analysis, summary, files))
 
     a("## Joint space and basic components (Figures 2 and 11)\n")
     a("Cells are connected sets of voxels certified off an outer enclosure of g(S); each cell's count and "
@@ -122,8 +124,8 @@ def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
           "shares of the layer touch), hence possibly one domain of the paper: "
           + ", ".join(f"{i}-{j}" for i, j in pairs) + ". If such cells were one domain, the basic regions above "
           "them would coincide and the count of basic regions would drop; this is why 28 is not claimed exact.\n")
-    a(_fig("joint_slices.png", "Joint space, rho3-slices by certified count (cf. Figs. 2, 11)", files))
-    a(_fig("joint_3d.png", "Joint space cells (cf. Fig. 11)", files))
+    for number in (2, 11):
+        a(figure_passage(number, analysis, summary, files))
 
     a("## Characteristic surfaces and basic regions (Figures 9, 10)\n")
     br = summary["basic_regions"]
@@ -135,11 +137,10 @@ def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
         parts.setdefault(jp.cells[cid].count, []).append(cid)
     a("Decomposition: " + " + ".join(f"{len(v)} cell(s) with {k} solutions ({k * len(v)} regions)"
                                     for k, v in sorted(parts.items()))
-      + f" = {sum(k * len(v) for k, v in parts.items())} basic regions. The paper's description of Figure 11 "
-      "(\"the upper two domains contain two coincident basic components, the middle four domains are composed "
-      "of four coincident domains, and the last two domains contain six\") read as 2 + 4 + 2 disjoint domains "
-      "would give 2x2 + 4x4 + 2x6 = 32 regions, not 28; the decomposition found here adds up to the paper's "
-      "count.\n")
+      + f" = {sum(k * len(v) for k, v in parts.items())} basic regions. The paper describes Figure 11 as two "
+      "upper domains made of two coincident components each, four middle domains of four, and two last domains "
+      "of six; read as 2 + 4 + 2 disjoint domains, that description would give 2x2 + 4x4 + 2x6 = 32 regions, "
+      "not 28; the decomposition found here adds up to the paper's count.\n")
     a("| cell | solutions | regions per aspect | sheets seen with boxes (WA1, WA2) |")
     a("|---|---|---|---|")
     for cid in realized:
@@ -149,8 +150,8 @@ def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
     a(f"\n{sum(r.count > 0 for r in jp.cells) - len(realized)} further cells with solutions carry no "
       "certified box at this depth (they are small pieces near g(S)); they are not counted. "
       f"Proposition 1 check: {'every sheet above every counted cell holds certified boxes' if ra.consistent else 'some sheets have no certified box yet (deeper subdivision needed there)'}.\n")
-    a(_fig("characteristic_slices.png", "Characteristic surfaces (outer enclosure, cf. Fig. 9)", files))
-    a(_fig("basic_regions_slices.png", "Basic regions (cf. Fig. 10)", files))
+    for number in (9, 10):
+        a(figure_passage(number, analysis, summary, files))
 
     a("## Uniqueness domains (Figure 12) and the six regions of one cell (Figure 13)\n")
     ud = summary["uniqueness_domains"]
@@ -160,8 +161,8 @@ def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
         a(f"- domain {gi}: regions {list(grp)} ({ra.regions[grp[0]].aspect}), cells "
           f"{[ra.regions[i].cell for i in grp]}")
     a("")
-    a(_fig("uniqueness_domains_slices.png", "Uniqueness domains (cf. Fig. 12)", files))
-    a(_fig("top_cell_regions_3d.png", "The basic regions above the 6-solution cell (cf. Fig. 13)", files))
+    for number in (12, 13):
+        a(figure_passage(number, analysis, summary, files))
 
     trs = summary.get("trajectories") or []
     if trs:
@@ -185,11 +186,16 @@ def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
               f"{cells} | {'yes' if t.get('through_two_solution_cell') else 'not seen at this depth'} |")
         a("")
         for t in trs:
-            if "folder" in t:
-                a(f"![Path {t['from']} -> {t['to']} in the workspace]({t['folder']}/trajectory_workspace_xy.png)\n")
-                a(f"![Path {t['from']} -> {t['to']} in joint space]({t['folder']}/trajectory_joint.png)\n")
-        a("The animations are in `trajectories/*/trajectory_animation.gif`. Each certified path is also a claim "
-          "in `certificates/trajectory.json`, which `intervalkin verify` re-proves piece by piece in arb.\n")
+            for name, where in (("trajectory_workspace_xy.png", "in the workspace"),
+                                ("trajectory_workspace_3d.png", "in (x, y, phi); an X marks each crossing of the "
+                                 "seam phi = +-180 deg"),
+                                ("trajectory_joint.png", "in joint space")):
+                path = f"{t.get('folder')}/{name}"
+                if "folder" in t and path in files:  # only files this run wrote
+                    a(f"![Path {t['from']} -> {t['to']} {where}]({path})\n")
+        a("The animations are `trajectory_animation.gif` in each `trajectories/` folder. Each certified path is "
+          "also a claim in `certificates/trajectory.json`, which `intervalkin verify` re-proves piece by piece "
+          "in arb.\n")
 
     a("## Depth, time, undecided volumes\n")
     for k, v in summary["timings_seconds"].items():
