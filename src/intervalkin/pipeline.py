@@ -4,7 +4,9 @@
 
 1. the singular layer: workspace boxes (depth + 1) covering every singular point of W;
 2. joint space: the outer enclosure of g(S) built from their images, and the cells of
-   certified solution count (2**min(depth - 1, 7) voxels per axis);
+   certified solution count (2**min(depth - 1, 7) voxels per axis); and the joint box
+   paved directly (:mod:`intervalkin.space.joint_paving`, the same depth, adaptive),
+   whose cells carry the count of basic regions;
 3. the regions paving (depth): W, the sign of det A, the aspects, the boxes certified off
    the characteristic surfaces; their pieces, sheets and basic regions, the distinctness
    witnesses;
@@ -31,9 +33,12 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any, Callable, Iterator, Mapping, Sequence
 
+import numpy as np
+
 from intervalkin.certify.writer import write_certificates
 from intervalkin.checker import INDEX, CheckResult, verify_directory
 from intervalkin.core.errors import InputError
+from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.geometry import Geometry, default_geometry
 from intervalkin.core.status import Status
 from intervalkin.paving.budget import check_depth
@@ -44,6 +49,9 @@ from intervalkin.space.basic_region import (
     analyse_regions,
     label_pose,
 )
+from intervalkin.space.joint_cells import regions_from_cells
+from intervalkin.space.joint_paving import JOIN_LEVELS, JointSpacePaving
+from intervalkin.space.joint_paving import pave_joint_space as pave_joint_cells
 from intervalkin.space.joint_space import JointPaving, joint_paving
 from intervalkin.space.pose_label import PoseLabel
 from intervalkin.space.singular_surface import pave_singular_layer
@@ -62,15 +70,19 @@ class ProgressEvent:
     """One step of a running analysis, for a progress display.
 
     ``kind`` is ``"start"``, ``"level"`` (one paving level done; ``level`` holds the
-    paver's statistics: level, depth, boxes, split, seconds) or ``"done"``;
-    ``stage`` names the stage (the key of its time in :attr:`Analysis.timings`);
-    ``seconds`` is the time since the stage started.
+    paver's statistics: level, depth, boxes, split, seconds), ``"fraction"`` (a
+    stage without levels says how much of its work is done: ``fraction`` in
+    [0, 1], ``detail`` names the work) or ``"done"``; ``stage`` names the stage
+    (the key of its time in :attr:`Analysis.timings`); ``seconds`` is the time
+    since the stage started.
     """
 
     stage: str
     kind: str
     seconds: float
     level: Mapping[str, Any] | None = None
+    fraction: float | None = None
+    detail: str = ""
 
 
 ProgressCallback = Callable[[ProgressEvent], None]
@@ -123,7 +135,10 @@ class Analysis:
     geometry : the manipulator analysed.
     depth, singular_depth, joint_depth : the regions paving's depth, the singular
         layer's depth, and the joint grid's (2**joint_depth voxels per axis).
-    joint : the joint-space grid: enclosure of g(S), cells with certified counts.
+    joint : the joint-space grid: enclosure of g(S) by images of workspace boxes, cells with
+        certified counts (the regions paving finds its sheets through it).
+    cells : the joint box paved directly (boxes proved off g(S), adaptive), its cells with
+        certified counts: the basic regions are counted over these, every cell included.
     regions : aspects, pieces, basic regions, witnesses, uniqueness domains, per box and in all.
     timings : seconds per stage, keyed by the stage names of the progress events.
     refinement : each depth the regions paving was tried at, and why it stopped.
@@ -134,6 +149,7 @@ class Analysis:
     singular_depth: int
     joint_depth: int
     joint: JointPaving
+    cells: JointSpacePaving
     regions: RegionAnalysis
     timings: Mapping[str, float]
     refinement: tuple[RefinementStep, ...]
@@ -144,12 +160,23 @@ class Analysis:
         return self.joint.n_singular_boxes
 
     def counts(self) -> RegionCounts:
-        """Aspects, basic regions and uniqueness domains, each a :class:`~intervalkin.core.status.Count`."""
-        return self.regions.counts()
+        """Aspects, basic regions and uniqueness domains, each a :class:`~intervalkin.core.status.Count`.
 
-    def label(self, pose: Sequence) -> PoseLabel:
-        """Certified aspect, basic region and uniqueness domain of a pose (x, y, phi), read exactly."""
-        return label_pose(self.regions, pose)
+        The basic regions are counted over every cell of the direct joint paving
+        (:func:`~intervalkin.space.joint_cells.regions_from_cells`), not over the cells
+        that happen to receive certified workspace boxes.
+        """
+        counts = self.regions.counts()
+        return dataclasses.replace(counts, basic_regions=regions_from_cells(self.cells.cells, counts.basic_regions.lower))
+
+    def label(self, pose: Sequence, refine: bool = True) -> PoseLabel:
+        """Certified aspect, basic region and uniqueness domain of a pose (x, y, phi), read exactly.
+
+        phi is reduced modulo 2 pi; a pose outside the paved domain raises InputError; where the
+        paving leaves a label open, the pose itself and (``refine``, up to a few seconds) a
+        certified path to a labelled box decide it (:mod:`intervalkin.space.pose_label`).
+        """
+        return label_pose(self.regions, pose, self.geometry, self.joint, refine)
 
     def locate(self, rho: Sequence) -> JointLocation:
         """The joint cell of a joint vector and its certified count and aspect split.
@@ -169,6 +196,12 @@ class Analysis:
         where = (f"rho lies in joint cell {cid}, whose solve was not completed" if cid >= 0 else
                  "rho lies on the undecided layer of the joint grid (it may be near g(S))")
         cell = cid if cid >= 0 else None
+        direct = int(self.cells.cell_of(np.array([[fraction_bounds(v) for v in q]]))[0])
+        found = next((c for c in self.cells.cells if c.id == direct and c.count >= 0), None)
+        if found is not None:
+            return JointLocation(q, cell, found.count, found.n_wa1, found.n_wa2, Status.CERTIFIED,
+                                 f"{where}; it lies in cell {direct} of the direct joint paving, whose boxes are "
+                                 "proved off g(S): the certified solve at that cell's witness gives its count")
         res = dkp.solve(self.geometry, q)
         if res.complete and all(s.status == "unique" and s.det_sign != 0 for s in res.solutions):
             n1 = sum(1 for s in res.solutions if s.det_sign > 0)
@@ -184,7 +217,7 @@ class Analysis:
         :func:`verify` re-proves every claim from the files alone.
         """
         return write_certificates(folder, self.geometry, dkp_results=dkp_results, joint=self.joint,
-                                  regions=self.regions, trajectories=trajectories)
+                                  regions=self.regions, trajectories=trajectories, counts=self.counts())
 
 
 @dataclass(frozen=True)
@@ -246,12 +279,22 @@ class _Stages:
         if report is not None:
             report(ProgressEvent(name, "done", self.timings[name]))
 
+    def fractions(self, name: str) -> Callable[[str, float], None] | None:
+        """A ``(detail, fraction)`` callback reporting "fraction" events of stage ``name`` (None without a callback)."""
+        report = self.progress
+        if report is None:
+            return None
+        t0 = time.perf_counter()
+        return lambda detail, done: report(ProgressEvent(name, "fraction", time.perf_counter() - t0,
+                                                         fraction=float(done), detail=detail))
+
 
 def _joint_space(geometry: Geometry, singular_depth: int, joint_depth: int, stages: _Stages) -> JointPaving:
     with stages.stage(f"singular layer (depth {singular_depth})") as levels:
         singular = pave_singular_layer(geometry, singular_depth, progress=levels)
-    with stages.stage(f"joint space: enclosure of g(S) and certified cells (2^{joint_depth} voxels per axis)"):
-        return joint_paving(geometry, singular, joint_depth)
+    name = f"joint space: enclosure of g(S) and certified cells (2^{joint_depth} voxels per axis)"
+    with stages.stage(name):
+        return joint_paving(geometry, singular, joint_depth, progress=stages.fractions(name))
 
 
 def pave_joint_space(geometry: Geometry | None = None, singular_depth: int = DEFAULT_DEPTH + 1,
@@ -290,6 +333,8 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     dw, ds, dj = chain_depths(depth)
     stages = _Stages(progress)
     joint = _joint_space(geometry, ds, dj, stages)
+    with stages.stage(f"joint space paved directly (depth {dj}, {JOIN_LEVELS} join levels)") as levels:
+        cells = pave_joint_cells(geometry, dj, JOIN_LEVELS, progress=levels)
     with stages.stage(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})") as levels:
         regions = analyse_regions(geometry, joint, dw, progress=levels)
     history = [RefinementStep(dw, regions.consistent, len(regions.regions))]
@@ -305,7 +350,7 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     else:
         stopped = f"limit reached (depth {dw}) before consistency"
     history[-1] = dataclasses.replace(history[-1], stopped=stopped)
-    return Analysis(geometry, dw, ds, dj, joint, regions, dict(stages.timings), tuple(history))
+    return Analysis(geometry, dw, ds, dj, joint, cells, regions, dict(stages.timings), tuple(history))
 
 
 def verify(path: str | Path) -> VerifyReport:

@@ -19,7 +19,7 @@ from intervalkin.core.geometry import default_geometry
 from intervalkin.solve.dkp import parse_joint_vector, solve
 
 TABLE1 = ["14.98", "15.38", "12.0"]
-SUBCOMMANDS = ("dkp", "table1", "pave", "joint", "analyze", "paper", "label", "trajectory", "verify")
+SUBCOMMANDS = ("dkp", "table1", "pave", "joint", "analyze", "paper", "label", "locate", "trajectory", "verify")
 
 
 def _run(argv) -> int:
@@ -41,6 +41,18 @@ def _one_line_error(capsys, fragment: str | None = None) -> str:
     if fragment is not None:
         assert fragment in lines[0], (fragment, lines[0])
     return lines[0]
+
+
+def _usage_error(capsys, command: str | None, fragment: str) -> str:
+    """Assert argparse's refusal: nothing on stdout; on stderr the usage on one line, then one error line."""
+    out, err = capsys.readouterr()
+    assert out == "", out
+    assert "Traceback" not in err
+    lines = err.splitlines()
+    assert len(lines) == 2 and err.endswith("\n"), err
+    assert lines[0].startswith("usage: intervalkin" + (f" {command} " if command else " ")), lines[0]
+    assert lines[1].startswith("intervalkin: error: ") and fragment in lines[1], (fragment, lines[1])
+    return lines[1]
 
 
 def _cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
@@ -81,6 +93,7 @@ _WITH_GEOMETRY = {
     "joint": ["joint", "--depth", "3"],
     "analyze": ["analyze", "--depth", "3"],
     "label": ["label", "1", "2", "0.5", "--depth", "3"],
+    "locate": ["locate", *TABLE1, "--depth", "3"],
     "trajectory": ["trajectory", "--rho", *TABLE1, "--from", "2", "--to", "3", "--depth", "3"],
 }
 
@@ -146,8 +159,6 @@ def test_bad_values_are_refused_in_one_line(argv, fragment, capsys):
     (["paper", "--depth", "3", "--refine-to", "2"], "refine_to: expected an integer in 3..9, got 2"),
     (["label", "1", "2", "3", "--depth", "1"], "depth: expected an integer in 3..9, got 1"),
     (["trajectory", "--rho", *TABLE1, "--from", "2", "--to", "3", "--depth", "0"], "depth: expected"),
-    (["pave", "--depth", "x"], "--depth"),
-    (["analyze", "--depth", "4.5"], "--depth"),
 ])
 def test_depth_out_of_range_is_refused_before_any_work(argv, fragment, tmp_path, capsys):
     """Depths outside a command's range: status 2, one line naming the depth, and no output folder created.
@@ -160,6 +171,16 @@ def test_depth_out_of_range_is_refused_before_any_work(argv, fragment, tmp_path,
         argv = argv + ["--out", str(out)]
     assert _run(argv) == 2
     _one_line_error(capsys, fragment)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("argv", [["pave", "--depth", "x"], ["analyze", "--depth", "4.5"], ["label", "1", "2", "3",
+                                                                                          "--depth", "seven"]])
+def test_depth_that_is_not_an_integer_is_a_usage_error(argv, tmp_path, capsys):
+    """argparse refuses a depth that is not an integer: usage line, one error line naming --depth, status 2."""
+    out = tmp_path / "o"
+    assert _run(argv + (["--out", str(out)] if argv[0] != "label" else [])) == 2
+    _usage_error(capsys, argv[0], "--depth")
     assert not out.exists()
 
 
@@ -235,22 +256,33 @@ def test_label_of_a_pose_beyond_float_range_is_bad_input(tmp_path, capsys):
 @pytest.mark.parametrize("argv, fragment", [
     (["frobnicate"], "invalid choice"),
     ([], "required"),
-    (["dkp"], "required"),
-    (["dkp", "14.98", "15.38"], "required"),
+    (["dkp"], "required: R1, R2, R3"),
+    (["dkp", "14.98", "15.38"], "required: R3"),
     (["dkp", "14.98", "15.38", "12", "13"], "unrecognized"),
-    (["label", "1", "2"], "required"),
+    (["label", "1", "2"], "required: PHI"),
+    (["locate", "15"], "required: R2, R3"),
     (["trajectory", "--rho", "1", "--from", "1", "--to", "2"], "--rho"),
     (["table1", "--bogus"], "unrecognized"),
 ])
-def test_usage_errors_are_one_line_status_2(argv, fragment, capsys):
-    """argparse's own errors go through the one-line error path, with status 2.
+def test_usage_errors_show_the_usage_and_one_error_line(argv, fragment, capsys):
+    """argparse's own errors: the command's usage on one line, one error line naming what is wrong, status 2.
 
     Would catch: the tuple metavar of a 3-value positional (``dkp 14.98 15.38`` and a bare
-    ``dkp`` raised TypeError while argparse listed the missing arguments), or a
-    parser that prints its full usage block.
+    ``dkp`` raised TypeError while argparse listed the missing arguments), a usage wrapped
+    over several lines (a script reading stderr sees more than two lines), or an error line
+    that does not say which argument is missing.
     """
     assert _run(argv) == 2
-    _one_line_error(capsys, fragment)
+    command = argv[0] if argv and argv[0] in SUBCOMMANDS else None
+    _usage_error(capsys, command, fragment)
+
+
+def test_version(capsys):
+    """``intervalkin --version`` prints the package version and exits 0."""
+    from intervalkin.core.version import __version__
+
+    assert _run(["--version"]) == 0
+    assert capsys.readouterr().out == f"intervalkin {__version__}\n"
 
 
 @pytest.mark.parametrize("command", SUBCOMMANDS)
@@ -288,7 +320,10 @@ def test_reported_crashes_through_the_real_entry_point(args, status):
     if status == 0:
         assert r.stdout.startswith(f"usage: intervalkin {args[0]}") and r.stderr == ""
     else:
-        assert r.stdout == "" and r.stderr.count("\n") == 1 and r.stderr.startswith("intervalkin: error: ")
+        lines = r.stderr.splitlines()
+        assert r.stdout == "" and lines[-1].startswith("intervalkin: error: ")
+        # a value refused by intervalkin: one line; a command line argparse cannot read: usage + one line
+        assert len(lines) == (1 if "nan" in args else 2) and (len(lines) == 1 or lines[0].startswith("usage: "))
 
 
 def test_internal_failure_is_status_1_in_one_line(monkeypatch, capsys):

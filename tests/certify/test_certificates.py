@@ -78,10 +78,10 @@ def _failed(d: Path) -> list[checker.CheckResult]:
 
 
 def _refused(d: Path, capsys, file: str, claim: str | None = None) -> str:
-    """Assert the CLI exits 1 and prints a FAILED line for the claim; return that line."""
+    """Assert the CLI exits 2 (bad certificates) and prints a FAILED line for the claim; return that line."""
     bad = _failed(d)
     assert any(r.file == file and (claim is None or r.claim == claim) for r in bad), [r.line() for r in bad]
-    assert main(["verify", str(d)]) == 1
+    assert main(["verify", str(d)]) == 2
     out = capsys.readouterr().out
     lines = [ln for ln in out.splitlines() if ln.startswith(f"FAILED: {file}#{claim or ''}")]
     assert lines, out
@@ -351,7 +351,7 @@ def test_tamper_geometry_decimal_everywhere(cert_dir, tmp_path, capsys):
     bad = {(r.file, r.claim) for r in _failed(d)}
     assert ("dkp.json", "q-0") in bad and ("counts.json", "basic_regions") in bad
     assert all(("joint_cell.json", c["id"]) in bad for c in _load(d, "joint_cell.json")["claims"] if c["count"] > 0)
-    assert main(["verify", str(d)]) == 1
+    assert main(["verify", str(d)]) == 2
     capsys.readouterr()
 
 

@@ -350,13 +350,18 @@ def _edit_solution(**kw):
 ], ids=["rho-floats", "rho-short", "rho-negative", "complete-str", "solutions-object", "prec-low", "prec-high",
         "phi0-str", "box-short", "sign-zero", "phi-wide", "geometry"])
 def test_malformed_claim_is_a_failed_line_not_a_crash(honest, tmp_path, capsys, edit, why):
-    """A claim with a malformed field is FAILED (status 1) with the reason; the checker does not raise."""
+    """A claim with a malformed field is FAILED with the reason; the checker does not raise.
+
+    The command exits 2 (the certificates given are bad input), with the verdicts on
+    stdout and one error line on stderr.
+    """
     d = _folder(honest, tmp_path, edit_dkp=edit)
     (r,) = checker.verify_directory(d)
     assert not r.verified and why in r.message, r.message
-    assert main(["verify", str(d)]) == 1
-    out = capsys.readouterr().out
+    assert main(["verify", str(d)]) == 2
+    out, err = capsys.readouterr()
     assert out.startswith("FAILED: dkp.json#q-0 (dkp) because ")
+    assert err.count("\n") == 1 and err.startswith("intervalkin: error: 0 of 1 claims verified")
 
 
 def test_malformed_geometry_toml_fails_each_claim(honest, tmp_path):

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from flint import arb, ctx
 
+from intervalkin.core.errors import InputError
 from intervalkin.kinematics.formulas import det_a_arb, inverse_kinematics_arb
 from intervalkin.solve.dkp import solve
 from intervalkin.paving.labels import Label
@@ -157,7 +158,7 @@ def test_label_pose_reports_what_the_paving_certifies(chain, paper_geometry):
       (decided at this depth), and its region / domain are exactly those of the paving
       box holding it (None only when that box has none);
     * a point drawn inside a box with a basic region gets that region, its aspect and its domain;
-    * B1 on A1 (rho_1 = 0) is certainly outside W; a pose beyond the paved domain lies in no box.
+    * B1 on A1 (rho_1 = 0) is certainly outside W; a pose beyond the paved domain is refused.
 
     Would catch a lookup that returns the label of a neighbouring box, drops the aspect, or
     answers "undecided" where the paving has decided.
@@ -185,8 +186,8 @@ def test_label_pose_reports_what_the_paving_certifies(chain, paper_geometry):
         assert (lab.basic_region, lab.aspect, lab.uniqueness_domain) == (r.id, r.aspect, own(i, ra.domain))
     out = label_pose(ra, ("0", "0", "0.5"))
     assert out.in_workspace is False and out.aspect is None and out.boxes > 0
-    far = label_pose(ra, ("40", "40", "0"))
-    assert far.boxes == 0 and far.in_workspace is None and far.basic_region is None
+    with pytest.raises(InputError, match="outside the paved domain"):  # issue 15: an error, not "undecided"
+        label_pose(ra, ("40", "40", "0"))
 
 
 # --------------------------------------------------------------------------------------

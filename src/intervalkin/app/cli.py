@@ -1,9 +1,21 @@
 """The ``intervalkin`` command: a thin layer over the library.
 
-Exit status: 0 on success, 2 on bad input (one line on stderr, no traceback),
-1 on an internal failure.  Each sub-command has one ``_cmd_*`` function that
-parses nothing itself: argparse validates the shapes, the library validates the
-values and raises :class:`~intervalkin.core.errors.IntervalkinError` subclasses.
+Exit status: 0 on success; 2 on bad input, with one line on stderr and no
+traceback; 1 on an internal failure (one line too).  What counts as bad input:
+
+* a command line argparse cannot read (unknown command or option, a missing or
+  extra argument, a non-integer depth): argparse's usage line, then one error
+  line;
+* a value the library refuses (geometry file, joint vector, pose, depth range,
+  output folder, certificate folder): one error line, raised as
+  :class:`~intervalkin.core.errors.IntervalkinError` before any work where it
+  can be checked then;
+* a file-system failure while reading or writing (``OSError``): one line
+  naming the file;
+* ``verify`` on certificates that do not all re-prove: the verdicts on
+  stdout, one error line on stderr.
+
+Each sub-command has one ``_cmd_*`` function that parses nothing itself.
 """
 
 from __future__ import annotations
@@ -12,25 +24,33 @@ import argparse
 import json
 import signal
 import sys
-from typing import Callable, Sequence
+from typing import Callable, NoReturn, Sequence
 
 from intervalkin.app.commands import run_analyze, run_joint, run_pave, run_trajectory
-from intervalkin.app.label import run_label
-from intervalkin.app.options import geometry_from_option
+from intervalkin.app.label import run_label, run_locate
+from intervalkin.app.options import CHAIN_DEPTHS, JOINT_DEPTHS, PAVE_DEPTHS, depth_help, geometry_from_option
 from intervalkin.app.table1 import format_table1, table1_comparison
 from intervalkin.app.text import format_dkp_table
 from intervalkin.core.errors import IntervalkinError
+from intervalkin.core.version import __version__
 from intervalkin.pipeline import DEFAULT_DEPTH, verify
 from intervalkin.solve.dkp import parse_joint_vector, solve
 
 __all__ = ['build_parser', 'main']
 
+#: Default depth of the commands that run the chain for one question (label, locate, trajectory).
+QUESTION_DEPTH = 7
+
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors and exit status 2."""
+    """argparse whose errors are the usage on one line, one error line, and exit status 2."""
 
-    def error(self, message: str):  # type: ignore[override]
-        sys.stderr.write(f"intervalkin: error: {message}\n")
+    def error(self, message: str) -> NoReturn:  # type: ignore[override]
+        # the usage on ONE line whatever the terminal width, so that a script sees two lines
+        formatter = argparse.HelpFormatter(prog=self.prog, width=1 << 16)
+        formatter.add_usage(self.usage, self._actions, self._mutually_exclusive_groups)
+        usage = " ".join(formatter.format_help().split())
+        sys.stderr.write(f"{usage}\nintervalkin: error: {message}\n")
         sys.exit(2)
 
 
@@ -43,7 +63,7 @@ def _print_json(obj) -> None:
 # --------------------------------------------------------------------------------------
 def _cmd_dkp(args: argparse.Namespace) -> int:
     geometry = geometry_from_option(args.geometry)
-    rho = parse_joint_vector(geometry, args.rho)
+    rho = parse_joint_vector(geometry, [args.r1, args.r2, args.r3])
     result = solve(geometry, rho)
     if args.json:
         _print_json(result.to_json())
@@ -62,7 +82,7 @@ def _cmd_table1(args: argparse.Namespace) -> int:
 
 
 def _cmd_pave(args: argparse.Namespace) -> int:
-    return run_pave(geometry_path=args.geometry, depth=args.depth, out=args.out)
+    return run_pave(args.geometry, args.depth, args.out, force=args.force, quiet=args.quiet)
 
 
 def _cmd_joint(args: argparse.Namespace) -> int:
@@ -80,21 +100,30 @@ def _cmd_paper(args: argparse.Namespace) -> int:
 
 
 def _cmd_label(args: argparse.Namespace) -> int:
-    return run_label(args.geometry, args.pose, args.depth, source=args.source, as_json=args.json)
+    return run_label(args.geometry, [args.x, args.y, args.phi], args.depth, source=args.source, as_json=args.json)
+
+
+def _cmd_locate(args: argparse.Namespace) -> int:
+    return run_locate(args.geometry, [args.r1, args.r2, args.r3], args.depth, as_json=args.json)
 
 
 def _cmd_trajectory(args: argparse.Namespace) -> int:
     return run_trajectory(args.geometry, args.rho, args.i_from, args.i_to, depth=args.depth, out=args.out,
-                          as_json=args.json)
+                          as_json=args.json, quiet=args.quiet, force=args.force)
 
 
 def _cmd_verify(args: argparse.Namespace) -> int:
     results = verify(args.dir).results  # DIR: the certificate folder, or an output folder holding one
     for r in results:
         sys.stdout.write(r.line() + "\n")
-    failed = sum(1 for r in results if not r.verified)
-    sys.stderr.write(f"{len(results) - failed} of {len(results)} claims verified\n")
-    return 1 if failed else 0
+    failed = [r for r in results if not r.verified]
+    if failed:
+        first = failed[0]
+        sys.stderr.write(f"intervalkin: error: {len(results) - len(failed)} of {len(results)} claims verified; "
+                         f"{len(failed)} FAILED, the first {first.file}#{first.claim} ({first.kind})\n")
+        return 2
+    sys.stderr.write(f"{len(results)} of {len(results)} claims verified\n")
+    return 0
 
 
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
@@ -102,6 +131,7 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "analyze": _cmd_analyze,
     "paper": _cmd_paper,
     "label": _cmd_label,
+    "locate": _cmd_locate,
     "dkp": _cmd_dkp,
     "table1": _cmd_table1,
     "pave": _cmd_pave,
@@ -110,71 +140,105 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
 }
 
 
+def _three(p: argparse.ArgumentParser, names: Sequence[str], helps: Sequence[str]) -> None:
+    """Three positional numbers, one argument each: usage and errors then name the one missing."""
+    for name, text in zip(names, helps):
+        p.add_argument(name.lower(), metavar=name, help=text)
+
+
+def _out_options(p: argparse.ArgumentParser, default: str | None, what: str = "output folder") -> None:
+    """--out, --force and --quiet, the same on every command that writes a folder."""
+    p.add_argument("--out", default=default, metavar="DIR",
+                   help=f"{what} (default {default})" if default else what)
+    p.add_argument("--force", action="store_true",
+                   help="write into a non-empty folder: an earlier output's files are replaced, others are kept")
+    p.add_argument("--quiet", action="store_true", help="no progress and no table (progress shows only on a terminal)")
+
+
 def build_parser() -> argparse.ArgumentParser:
+    """The parser of every sub-command (also used by the tests to list them)."""
     parser = _Parser(
         prog="intervalkin",
         description="Certified definition sets of the planar 3-RPR parallel manipulator (Wenger & Chablat 1997).",
+        epilog="Exit status: 0 success, 2 bad input (one line on stderr), 1 internal failure.",
     )
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    parser.add_argument("--version", action="version", version=f"intervalkin {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser, metavar="COMMAND")
+    geometry_help = "geometry TOML file (default: the paper's manipulator)"
+    chain_depth = depth_help("depth of the regions paving", CHAIN_DEPTHS, QUESTION_DEPTH)
 
     p = sub.add_parser("dkp", help="certified direct kinematics: every assembly mode of a joint vector")
-    # one metavar string: argparse (3.11) crashes on a tuple metavar of a positional in --help and in
-    # its "arguments are required" message
-    p.add_argument("rho", nargs=3, metavar="RHO", help="the three leg lengths R1 R2 R3 (exact decimals)")
-    p.add_argument("--geometry", metavar="FILE", help="geometry TOML file (default: the paper's manipulator)")
+    _three(p, ("R1", "R2", "R3"), [f"length of leg {i} (exact decimal)" for i in (1, 2, 3)])
+    p.add_argument("--geometry", metavar="FILE", help=geometry_help)
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("table1", help="the paper's Table 1 beside the certified solutions")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("pave", help="certified pavings of the workspace, singular surface and aspects")
-    p.add_argument("--geometry", metavar="FILE")
-    p.add_argument("--depth", type=int, default=6, metavar="N", help="octree depth (default 6)")
-    p.add_argument("--out", default="intervalkin-pave", metavar="DIR", help="output folder")
+    p.add_argument("--geometry", metavar="FILE", help=geometry_help)
+    p.add_argument("--depth", type=int, default=6, metavar="N",
+                   help=depth_help("workspace octree depth", PAVE_DEPTHS, 6) + "; memory is checked first")
+    _out_options(p, "intervalkin-pave")
 
     p = sub.add_parser("joint", help="joint space: enclosure of g(S) and cells of certified solution count")
-    p.add_argument("--geometry", metavar="FILE")
-    p.add_argument("--depth", type=int, default=6, metavar="N", help="2**N voxels per axis (default 6)")
-    p.add_argument("--out", default="intervalkin-joint", metavar="DIR", help="output folder")
-    p.add_argument("--force", action="store_true", help="write into a non-empty folder")
-    p.add_argument("--quiet", action="store_true", help="no progress, no table")
+    p.add_argument("--geometry", metavar="FILE", help=geometry_help)
+    p.add_argument("--depth", type=int, default=6, metavar="N",
+                   help=depth_help("2**N voxels per joint-space axis", JOINT_DEPTHS, 6))
+    _out_options(p, "intervalkin-joint")
 
     for name, text in (("analyze", "the whole chain for any geometry: aspects, basic regions, uniqueness domains"),
                        ("paper", "regenerate the paper's results on its manipulator, with a report")):
         p = sub.add_parser(name, help=text)
         if name == "analyze":
-            p.add_argument("--geometry", metavar="FILE")
+            p.add_argument("--geometry", metavar="FILE", help=geometry_help)
         p.add_argument("--depth", type=int, default=DEFAULT_DEPTH, metavar="N",
-                       help=f"workspace octree depth (default {DEFAULT_DEPTH})")
-        p.add_argument("--out", default="intervalkin-paper" if name == "paper" else "intervalkin-analysis",
-                       metavar="DIR", help="output folder")
-        p.add_argument("--force", action="store_true", help="write into a non-empty folder that is not an earlier output")
-        p.add_argument("--quiet", action="store_true", help="no progress, no table")
+                       help=depth_help("workspace octree depth", CHAIN_DEPTHS, DEFAULT_DEPTH))
+        _out_options(p, "intervalkin-paper" if name == "paper" else "intervalkin-analysis")
         p.add_argument("--json", action="store_true", help="print summary.json on stdout")
         p.add_argument("--refine-to", type=int, metavar="M", default=None,
-                       help="deepen the regions paving, up to depth M, until every sheet of every counted cell "
-                            "holds certified boxes (Proposition 1 seen in full)")
+                       help=f"deepen the regions paving, up to depth M in N..{CHAIN_DEPTHS[1]}, until every sheet of "
+                            "every counted cell holds certified boxes (Proposition 1 seen in full)")
 
     p = sub.add_parser("label", help="certified aspect, basic region and uniqueness domain of a pose")
-    p.add_argument("pose", nargs=3, metavar="POSE", help="the pose X Y PHI: B1 = (X, Y), angle PHI in radians")
-    p.add_argument("--geometry", metavar="FILE")
-    p.add_argument("--depth", type=int, default=7, metavar="N", help="depth of the analysis (default 7)")
-    p.add_argument("--from", dest="source", metavar="DIR", help="read the pavings of an earlier analyze/paper output")
-    p.add_argument("--json", action="store_true")
+    _three(p, ("X", "Y", "PHI"), ("x of the platform point B1", "y of B1",
+                                  "angle of B1B2 in radians (any value: reduced modulo 2 pi)"))
+    p.add_argument("--geometry", metavar="FILE", help=geometry_help)
+    p.add_argument("--depth", type=int, default=QUESTION_DEPTH, metavar="N", help=chain_depth)
+    p.add_argument("--from", dest="source", metavar="DIR",
+                   help="read the pavings of an earlier analyze/paper output instead of running the analysis")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("locate", help="the joint cell of a joint vector and its certified number of solutions")
+    _three(p, ("R1", "R2", "R3"), [f"length of leg {i} (exact decimal)" for i in (1, 2, 3)])
+    p.add_argument("--geometry", metavar="FILE", help=geometry_help)
+    p.add_argument("--depth", type=int, default=QUESTION_DEPTH, metavar="N", help=chain_depth)
+    p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("trajectory", help="certified non-singular motion between two solutions of one aspect")
     p.add_argument("--rho", nargs=3, required=True, metavar=("R1", "R2", "R3"), help="leg lengths (exact decimals)")
     p.add_argument("--from", dest="i_from", type=int, required=True, metavar="I", help="start solution (as `dkp` numbers it)")
     p.add_argument("--to", dest="i_to", type=int, required=True, metavar="J", help="goal solution")
-    p.add_argument("--geometry", metavar="FILE")
-    p.add_argument("--depth", type=int, default=7, metavar="N", help="workspace octree depth (default 7)")
-    p.add_argument("--out", metavar="DIR", help="write trajectory.json and the figures here")
+    p.add_argument("--geometry", metavar="FILE", help=geometry_help)
+    p.add_argument("--depth", type=int, default=QUESTION_DEPTH, metavar="N", help=chain_depth)
+    _out_options(p, None, "write trajectory.json and the figures into this folder")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("verify", help="re-check a certificate folder with the independent checker (arb only)")
     p.add_argument("dir", metavar="DIR",
-                   help="folder holding index.json and the claim files, or an output folder holding certificates/")
+                   help="an output folder holding certificates/ (its summary.json is compared too), "
+                        "or a folder holding index.json and the claim files")
+    for p in sub.choices.values():
+        p.set_defaults(subparser=p)  # so that extra arguments are refused with the sub-command's usage
     return parser
+
+
+def _parse(parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> argparse.Namespace:
+    """Parse ``argv``; arguments left over are refused by the sub-command's parser (its usage, not the top one)."""
+    args, extra = parser.parse_known_args(argv)
+    if extra:
+        args.subparser.error(f"unrecognized arguments: {' '.join(extra)}")
+    return args
 
 
 def _terminate(signum, frame):  # pragma: no cover - exercised through a subprocess test
@@ -183,8 +247,7 @@ def _terminate(signum, frame):  # pragma: no cover - exercised through a subproc
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    args = _parse(build_parser(), argv)
     try:
         signal.signal(signal.SIGTERM, _terminate)
     except ValueError:  # not the main thread (e.g. called from a test runner thread)
@@ -194,11 +257,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     except IntervalkinError as exc:
         sys.stderr.write(f"intervalkin: error: {exc}\n")
         return 2
+    except BrokenPipeError:  # stdout closed by a pager or `head`: nothing more to say
+        return 0
+    except OSError as exc:  # the file system refused (permissions, a full disk): not a bug of the program
+        where = f"{exc.filename}: " if exc.filename else ""
+        sys.stderr.write(f"intervalkin: error: {where}{exc.strerror or exc}\n")
+        return 2
     except KeyboardInterrupt:
         sys.stderr.write("intervalkin: interrupted\n")
         return 130
-    except BrokenPipeError:
-        return 0
     except Exception as exc:  # an internal failure: one line, status 1
         sys.stderr.write(f"intervalkin: internal error: {type(exc).__name__}: {exc}\n")
         return 1

@@ -15,22 +15,22 @@ import json
 import re
 import sys
 import time
+from contextlib import nullcontext
 from pathlib import Path
 
 from intervalkin.app.animation import write_trajectory
 from intervalkin.app.export import paving_columns, write_npz, write_vtu_paving
 from intervalkin.app.figures import render_all, render_joint
-from intervalkin.app.options import geometry_from_option
+from intervalkin.app.options import check_joint_depth, geometry_from_option
 from intervalkin.app.output import (
-    MARKER,
+    OutputFolder,
     npz_bytes,
-    prepare_output_dir,
-    writable_folder,
     write_analysis_certificates,
     write_chain,
 )
-from intervalkin.app.progress import ProgressBar, Stages
+from intervalkin.app.progress import Stages
 from intervalkin.app.report import write_report
+from intervalkin.app.report_html import write_report_html
 from intervalkin.app.summary import (
     chain_table,
     joint_summary,
@@ -39,9 +39,9 @@ from intervalkin.app.summary import (
     pave_table,
 )
 from intervalkin.app.table1 import TABLE1_RHO
-from intervalkin.core.errors import InputError, IntervalkinError
+from intervalkin.core.errors import IntervalkinError
 from intervalkin.core.files import atomic_write_bytes, write_json
-from intervalkin.core.geometry import default_geometry
+from intervalkin.core.geometry import Geometry, default_geometry
 from intervalkin.paving.adjacency import shares_face
 from intervalkin.paving.budget import check_depth
 from intervalkin.paving.labels import Label
@@ -50,59 +50,91 @@ from intervalkin.pipeline import Analysis, analyse, check_chain_depth, pave_join
 from intervalkin.space.aspect import aspect_components
 from intervalkin.space.trajectory import check_request, trajectory
 
-__all__ = ['run_pave', 'run_joint', 'run_analyze', 'run_trajectory']
+__all__ = ['GEOMETRY_FILE', 'run_pave', 'run_joint', 'run_analyze', 'run_trajectory']
+
+#: The geometry of a run, as the exact TOML it was read from (``label --from`` reads it back).
+GEOMETRY_FILE = "geometry.toml"
 
 
-def run_pave(geometry_path, depth, out, figures: bool = True, progress: bool = True) -> int:
+def _begin(folder: OutputFolder, geometry: Geometry) -> None:
+    """The first files of a run: its geometry, and a summary.json that says the run has not completed."""
+    atomic_write_bytes(folder.root / GEOMETRY_FILE, geometry.to_toml().encode())
+    write_json(folder.root / "summary.json", {"complete": False, "command": folder.command,
+                                              "geometry": geometry.name})
+
+
+def _end(folder: OutputFolder, summary: dict) -> None:
+    """The last write of a run: the manifest marked complete, then summary.json with ``"complete": true``."""
+    summary["files"] = sorted(set(summary.get("files", [])) | {GEOMETRY_FILE})
+    folder.finish()
+    summary["complete"] = True
+    write_json(folder.root / "summary.json", summary)
+
+
+def run_pave(geometry_path, depth, out, figures: bool = True, progress: bool = True, force: bool = False,
+             quiet: bool = False) -> int:
     """``intervalkin pave``: W, the det A sign and the aspects at ``depth``, written into ``out``.
 
     Validates ``depth`` (integer 1..MAX_DEPTH, memory estimate against
-    MemAvailable) before any work.
+    MemAvailable) and the output folder before any work.
     """
     depth = check_depth(depth)
     geometry = geometry_from_option(geometry_path)
-    out = writable_folder(out)  # refused before the paving, not after
-    t0 = time.perf_counter()
-    paving = pave_workspace(geometry, depth, progress=ProgressBar() if progress else None)
-    t1 = time.perf_counter()
-    edges = shares_face(paving.level, paving.ijk, paving.depth)
-    aspect, info = aspect_components(paving, edges)
-    t2 = time.perf_counter()
-    write_npz(out / "pavings" / "workspace.npz", paving, aspect)
-    cols = paving_columns(paving, aspect)
-    write_vtu_paving(out / "pavings" / "workspace.vtu", paving,
-                     {k: cols[k] for k in ("in_workspace", "det_sign", "aspect", "depth")},
-                     mask=paving.labels["W"] != Label.OUTSIDE)
-    t3 = time.perf_counter()
-    fig_files = render_all(paving, out / "figures", base=geometry.base) if figures else []
-    t4 = time.perf_counter()
-    timings = {"paving": t1 - t0, "components": t2 - t1, "export": t3 - t2, "figures": t4 - t3, "total": t4 - t0}
-    summary = pave_summary(paving, info, timings)
-    summary["geometry"] = geometry.name
-    summary["files"] = ["pavings/workspace.npz", "pavings/workspace.vtu"] + [f"figures/{f.name}" for f in fig_files]
-    write_json(out / "summary.json", summary)
-    sys.stdout.write(pave_table(summary) + "\n")
+    folder = OutputFolder.open(out, force, "pave")  # refused before the paving, not after
+    out = folder.root
+    st = Stages(quiet=quiet or not progress)
+    with folder.recording():
+        _begin(folder, geometry)
+        t0 = time.perf_counter()
+        st.start(f"workspace paving (depth {depth})")
+        paving = pave_workspace(geometry, depth, progress=st.levels())
+        st.done()
+        t1 = time.perf_counter()
+        edges = shares_face(paving.level, paving.ijk, paving.depth)
+        aspect, info = aspect_components(paving, edges)
+        t2 = time.perf_counter()
+        st.start("writing pavings (npz, VTK)")
+        write_npz(out / "pavings" / "workspace.npz", paving, aspect)
+        cols = paving_columns(paving, aspect)
+        write_vtu_paving(out / "pavings" / "workspace.vtu", paving,
+                         {k: cols[k] for k in ("in_workspace", "det_sign", "aspect", "depth")},
+                         mask=paving.labels["W"] != Label.OUTSIDE)
+        st.done()
+        t3 = time.perf_counter()
+        st.start("figures")
+        fig_files = render_all(paving, out / "figures", base=geometry.base) if figures else []
+        st.done()
+        t4 = time.perf_counter()
+        timings = {"paving": t1 - t0, "components": t2 - t1, "export": t3 - t2, "figures": t4 - t3, "total": t4 - t0}
+        summary = {"complete": False, **pave_summary(paving, info, timings)}
+        summary["geometry"] = geometry.name
+        summary["files"] = ["pavings/workspace.npz", "pavings/workspace.vtu"] + [f"figures/{f.name}" for f in fig_files]
+        _end(folder, summary)
+    if not quiet:
+        sys.stdout.write(pave_table(summary) + "\n")
     return 0
 
 
 def run_joint(geometry_path, depth: int, out, force: bool = False, quiet: bool = False, figures: bool = True) -> int:
     """``intervalkin joint``: the enclosure of g(S), the certified cells and their table."""
-    if isinstance(depth, bool) or not isinstance(depth, int) or not 2 <= depth <= 8:
-        raise InputError(f"--depth: expected an integer in 2..8 (voxels per axis 2**depth), got {depth!r}")
+    depth = check_joint_depth(depth)
     geometry = geometry_from_option(geometry_path)
-    out = prepare_output_dir(out, force)
+    folder = OutputFolder.open(out, force, "joint")
+    out = folder.root
     st = Stages(quiet=quiet)
     ds = min(depth + 2, 10)
-    jp = pave_joint_space(geometry, ds, depth, progress=st)
-    atomic_write_bytes(out / "pavings" / "joint.npz", npz_bytes(jp.columns()))
-    files = ["pavings/joint.npz"]
-    if figures:
-        st.start("figures")
-        files += [f"figures/{f.name}" for f in render_joint(jp, out / "figures")]
-        st.done()
-    summary = {"geometry": geometry.name, "singular_depth": ds, "joint": joint_summary(jp),
-               "timings_seconds": st.timings, "files": files}
-    write_json(out / "summary.json", summary)
+    with folder.recording():
+        _begin(folder, geometry)
+        jp = pave_joint_space(geometry, ds, depth, progress=st)
+        atomic_write_bytes(out / "pavings" / "joint.npz", npz_bytes(jp.columns()))
+        files = ["pavings/joint.npz"]
+        if figures:
+            st.start("figures")
+            files += [f"figures/{f.name}" for f in render_joint(jp, out / "figures")]
+            st.done()
+        summary = {"complete": False, "geometry": geometry.name, "singular_depth": ds, "joint": joint_summary(jp),
+                   "timings_seconds": st.timings, "files": files}
+        _end(folder, summary)
     if not quiet:
         sys.stdout.write(joint_table(jp) + "\n")
     return 0
@@ -114,28 +146,32 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
     """``intervalkin analyze`` (and ``paper`` when paper=True): the whole chain into one folder."""
     geometry = default_geometry() if paper else geometry_from_option(geometry_path)
     check_chain_depth(depth, refine_to)  # before the output folder is made
-    out = prepare_output_dir(out, force)
-    st = Stages(quiet=quiet)
-    a = analyse(geometry, depth, progress=st, refine_to=refine_to)
-    summary = write_chain(a, out, figures=figures, stages=st)
-    trajs = []
-    if paper:  # before the certificates, which re-check these paths
-        st.start("certified trajectories between Table 1's solutions 2, 3, 6")
-        summary["trajectories"], trajs = _paper_trajectories(a, out, summary["files"])
-        st.done()
-    if certificates:
-        st.start("certificates")
-        summary["files"] += write_analysis_certificates(a, out, trajectories=trajs)
-        st.done()
-    if paper:
-        st.start("paper report")
+    folder = OutputFolder.open(out, force, "paper" if paper else "analyze")
+    out = folder.root
+    st = Stages(quiet=quiet or as_json)
+    with folder.recording():
+        _begin(folder, geometry)
+        a = analyse(geometry, depth, progress=st, refine_to=refine_to)
+        summary = write_chain(a, out, figures=figures, stages=st)
+        trajs = []
+        if paper:  # before the certificates, which re-check these paths
+            st.start("certified trajectories between Table 1's solutions 2, 3, 6")
+            summary["trajectories"], trajs = _paper_trajectories(a, out, summary["files"], st)
+            st.done()
+        if certificates:
+            st.start("certificates")
+            summary["files"] += write_analysis_certificates(a, out, trajectories=trajs)
+            st.done()
+        if paper:
+            st.start("paper report")
+            summary["timings_seconds"] = {**summary["timings_seconds"], **st.timings,
+                                          "total": time.perf_counter() - st.t0}
+            summary["files"].append(write_report(a, summary, out, st.timings))
+            summary["files"].append(write_report_html(a, summary, out))
+            st.done()
         summary["timings_seconds"] = {**summary["timings_seconds"], **st.timings,
                                       "total": time.perf_counter() - st.t0}
-        summary["files"].append(write_report(a, summary, out, st.timings))
-        st.done()
-    summary["timings_seconds"] = {**summary["timings_seconds"], **st.timings,
-                                  "total": time.perf_counter() - st.t0}
-    write_json(out / "summary.json", summary)
+        _end(folder, summary)
     if as_json:
         sys.stdout.write(json.dumps(summary) + "\n")
     elif not quiet:
@@ -143,14 +179,14 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
     return 0
 
 
-def _paper_trajectories(a: Analysis, out: Path, files: list[str]) -> tuple[list[dict], list]:
+def _paper_trajectories(a: Analysis, out: Path, files: list[str], st: Stages) -> tuple[list[dict], list]:
     """Certified non-singular paths between Table 1's solutions 2, 3 and 6 (paper section 3.2, Fig. 13).
 
     Returns the report entries (one per pair, failures included) and the
     :class:`~intervalkin.space.trajectory.Trajectory` objects found (for the certificates).
     """
     done, found = [], []
-    for i, j in ((2, 3), (2, 6), (3, 6)):
+    for i, j in st.iterate(((2, 3), (2, 6), (3, 6)), "trajectories"):
         try:
             tr = trajectory(a.geometry, TABLE1_RHO, i, j, analysis=a.regions, joint=a.joint)
         except IntervalkinError as exc:
@@ -181,25 +217,27 @@ def _check_trajectory_request(geometry, rho, i_from: int, i_to: int) -> None:
 
 
 def run_trajectory(geometry_path, rho, i_from: int, i_to: int, depth: int = 7, out=None,
-                   as_json: bool = False, quiet: bool = False) -> int:
+                   as_json: bool = False, quiet: bool = False, force: bool = False) -> int:
     """``intervalkin trajectory``: the chain at ``depth``, then a certified path between two solutions.
 
-    The request is checked first (solutions of different aspects are refused at
-    once, before any paving).
+    The request, the depth and the output folder are checked first (solutions of
+    different aspects are refused at once, before any paving).
     """
     geometry = geometry_from_option(geometry_path)
     _check_trajectory_request(geometry, rho, i_from, i_to)
     check_chain_depth(depth)
-    if out is not None:
-        earlier = Path(out).is_dir() and (Path(out) / MARKER).exists()
-        out = prepare_output_dir(out, force=earlier)
+    folder = None if out is None else OutputFolder.open(out, force, "trajectory")
     st = Stages(quiet=quiet or as_json)
-    a = analyse(geometry, depth, progress=st)
-    st.start("certified path")
-    traj = trajectory(geometry, rho, i_from, i_to, analysis=a.regions, joint=a.joint)
-    st.done()
-    if out is not None:
-        write_trajectory(traj, geometry, out, paving=a.regions.paving, joint=a.joint)
+    # no path found (NoPathError) leaves no folder behind: recording() removes what the run made
+    with folder.recording() if folder is not None else nullcontext():
+        a = analyse(geometry, depth, progress=st)
+        st.start("certified path")
+        traj = trajectory(geometry, rho, i_from, i_to, analysis=a.regions, joint=a.joint)
+        st.done()
+        if folder is not None:
+            atomic_write_bytes(folder.root / GEOMETRY_FILE, geometry.to_toml().encode())
+            write_trajectory(traj, geometry, folder.root, paving=a.regions.paving, joint=a.joint)
+            folder.finish()
     if as_json:
         sys.stdout.write(json.dumps(traj.to_json()) + "\n")
     else:

@@ -119,6 +119,8 @@ def _hexahedra(lo, hi, depth: int, domain, fields: Mapping[str, np.ndarray], sca
     code = np.zeros(len(lo), dtype=np.int64)
     for k in names:
         v = np.asarray(kept[k], dtype=np.int64)
+        if v.size == 0:  # no box at all (a shallow run): an empty mesh
+            continue
         code = code * (int(v.max() - v.min()) + 1) + (v - v.min())
     _, first, key = np.unique(code, return_index=True, return_inverse=True)
     m_lo, m_hi, m_key = merge_boxes(lo, hi, key.reshape(-1))

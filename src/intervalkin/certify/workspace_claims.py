@@ -153,9 +153,9 @@ def box_labels_claim(paving, sample: int, seed: int, precision: int = 128) -> di
     }
 
 
-def counts_claims(analysis, aspect_refs: Sequence[str], solve_refs: Sequence[str]) -> list[dict]:
-    """The declared counts of ``RegionAnalysis.counts()`` with the claims supporting their lower bounds."""
-    c = analysis.counts().to_json()
+def counts_claims(analysis, aspect_refs: Sequence[str], solve_refs: Sequence[str], counts=None) -> list[dict]:
+    """The declared counts (``counts``, else ``RegionAnalysis.counts()``) with the claims supporting their lower bounds."""
+    c = (analysis.counts() if counts is None else counts).to_json()
     out = []
     for name, refs, why in (
         ("aspects", aspect_refs, "opposite certified signs of det A inside W"),

@@ -28,7 +28,8 @@ Modules: :mod:`~intervalkin.checker.parse` (reading fields exactly),
 :mod:`~intervalkin.checker.model` (the arb model), :mod:`~intervalkin.checker.labels`
 (box labels), :mod:`~intervalkin.checker.solutions` (direct kinematics),
 :mod:`~intervalkin.checker.trajectory` (motions), :mod:`~intervalkin.checker.claims`
-(one check per kind, counts), :mod:`~intervalkin.checker.folder` (a whole folder).
+(one check per kind, counts), :mod:`~intervalkin.checker.consistency` (counts against
+their proofs and the summary), :mod:`~intervalkin.checker.folder` (a whole folder).
 
 Re-proved per claim type
 ------------------------
@@ -74,8 +75,13 @@ Re-proved per claim type
 ``counts``
     Each declared lower bound is recomputed from the referenced claims that
     verified (rules in :func:`~intervalkin.checker.claims.count_bound`); a
-    declared lower bound larger than the recomputed one, or a count declared
-    exact, is refused.
+    declared lower bound larger than the recomputed one, a count declared
+    exact, or a library count ``found`` below the recomputed bound is refused.
+    When the folder is ``DIR/certificates`` of an output folder, the count
+    blocks of ``DIR/summary.json`` (what the user was shown) must agree with
+    the claims: same count and lower bound, no count below a proved bound, no
+    exact count without a proved upper bound
+    (:mod:`~intervalkin.checker.consistency`).
 """
 
 from intervalkin.checker.claims import check_claim

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from flint import ctx
 
+from intervalkin.checker.consistency import check_found, check_summary_block
 from intervalkin.checker.labels import (
     det_negative,
     det_positive,
@@ -248,8 +249,14 @@ def count_bound(name: str, support: list[dict]) -> int:
     raise Refused(f"unknown count {name!r} (known: aspects, basic_regions, uniqueness_domains)")
 
 
-def check_count(claim: dict, verified: dict[str, dict]) -> tuple[str, dict]:
-    """Re-check one ``counts`` claim against the facts of the claims verified so far ("file#id" -> facts)."""
+def check_count(claim: dict, verified: dict[str, dict], summary: dict | None = None) -> tuple[str, dict]:
+    """Re-check one ``counts`` claim against the facts of the claims verified so far ("file#id" -> facts).
+
+    The declared lower bound must be backed by the verified support, the
+    library's ``found`` must not fall below what that support proves, and, when
+    ``summary`` (the output folder's summary.json) is given, its block for this
+    count must agree (:mod:`intervalkin.checker.consistency`).
+    """
     name = get(claim, "name")
     declared = read_int(get(claim, "lower_bound"), "lower_bound", 0)
     if claim.get("exact") is not False:
@@ -264,5 +271,8 @@ def check_count(claim: dict, verified: dict[str, dict]) -> tuple[str, dict]:
         raise Refused(f"declared lower bound {declared} exceeds {bound}, what the {len(used)} verified "
                       f"supporting claims (of {len(refs)} referenced) prove")
     found = claim.get("found")
+    check_found(name, found, bound)
     extra = f"; {found} found by the library (not certified)" if found is not None else ""
-    return f"{name} >= {declared} (the {len(used)} verified supporting claims prove >= {bound}){extra}", {}
+    extra += check_summary_block(name, claim, bound, summary)
+    facts = {"name": name, "lower_bound": declared, "proved": bound, "found": found}
+    return f"{name} >= {declared} (the {len(used)} verified supporting claims prove >= {bound}){extra}", facts

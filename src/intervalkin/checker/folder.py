@@ -25,6 +25,7 @@ from intervalkin.checker.claims import (
     malformed_message,
     run_check,
 )
+from intervalkin.checker.consistency import read_summary
 from intervalkin.checker.parse import FORMAT, INDEX, KINDS, VERSION, Refused
 from intervalkin.core.errors import CertificateFormatError, GeometryError
 from intervalkin.core.geometry import Geometry, parse_geometry
@@ -81,15 +82,21 @@ def _geometry(text: Any) -> Geometry:
         raise Refused(f"geometry_toml: {exc}") from None
 
 
-def verify_directory(path: str | Path) -> list[CheckResult]:
+def verify_directory(path: str | Path, compare_summary: bool = True) -> list[CheckResult]:
     """Re-check every claim of a certificate folder; one :class:`CheckResult` per claim.
 
     Raises :class:`CertificateFormatError` when the folder, its ``index.json`` or
     a listed file is missing, unreadable or not in the format (a malformed
     folder is not a failed claim).  A claim whose fields are wrong, or whose
     evidence does not re-prove it, gives a result with ``verified`` False.
+
+    When the folder is the ``certificates/`` of an output folder and
+    ``compare_summary`` is True, each ``counts`` claim is also compared with the
+    output's summary.json (:mod:`intervalkin.checker.consistency`): a printed
+    count that contradicts the certificates fails that claim.
     """
     root = Path(path)
+    summary = read_summary(root) if compare_summary else None
     if not root.is_dir():
         raise CertificateFormatError(f"{root}: not a certificate folder (no such directory)")
     index = _read_json(root / INDEX)
@@ -138,7 +145,7 @@ def verify_directory(path: str | Path) -> list[CheckResult]:
                 continue
             try:
                 if kind == "counts":
-                    msg, facts = check_count(claim, verified)
+                    msg, facts = check_count(claim, verified, summary)
                 else:
                     msg, facts = run_check(geometry, kind, claim, doc.get("precision", 128))
             except Refused as exc:

@@ -9,6 +9,11 @@ file is removed and the destination is left as it was.
 
 Every output of the package goes through here: pavings (npz, VTK), JSON
 summaries, certificate files, reports, figures and the trajectory animation.
+So this is also where a command learns which files it wrote: inside
+:func:`watching_writes`, every destination is reported to a callback just
+before it is moved in place (the output folder's manifest is kept that way,
+and a file is listed before it exists, never after: an interrupted run leaves
+no unlisted file behind).
 """
 
 from __future__ import annotations
@@ -16,10 +21,30 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
-from typing import IO, Any, Callable
+from typing import IO, Any, Callable, Iterator
 
-__all__ = ['atomic_write', 'atomic_write_bytes', 'write_json']
+__all__ = ['atomic_write', 'atomic_write_bytes', 'write_json', 'watching_writes']
+
+#: Callbacks told of each destination before it is replaced (see :func:`watching_writes`).
+_watchers: list[Callable[[Path], None]] = []
+
+
+@contextmanager
+def watching_writes(callback: Callable[[Path], None]) -> Iterator[None]:
+    """Within the ``with`` block, call ``callback(path)`` for every file :func:`atomic_write` is about to create.
+
+    The call comes after the data are on disk under the temporary name and
+    before the rename, so a callback that records ``path`` records it before the
+    file appears.  If the callback raises, the write is abandoned (the
+    temporary file is removed) and the exception propagates.
+    """
+    _watchers.append(callback)
+    try:
+        yield
+    finally:
+        _watchers.remove(callback)
 
 
 def atomic_write(path, write: Callable[[IO[bytes]], Any]) -> Path:
@@ -39,6 +64,8 @@ def atomic_write(path, write: Callable[[IO[bytes]], Any]) -> Path:
         mask = os.umask(0)
         os.umask(mask)
         os.chmod(tmp, 0o666 & ~mask)  # mkstemp creates 0600; give the usual permissions
+        for watch in list(_watchers):
+            watch(path)
         os.replace(tmp, path)
     except BaseException:
         try:

@@ -16,11 +16,12 @@ aspect, off S_c, on that sheet.
 
 Counts (DESIGN.md sections 6 and 8): two regions are certified different when
 their aspects differ (opposite det A signs), when their cells have different
-certified counts (different basic components), or when one joint vector has a
-certified solution in each (Theorem 1).  The lower bound is the size of a set
-of regions pairwise different by these witnesses: per aspect, the sheets of
-one cell per distinct count.  No upper bound is proved: two cells of equal
-count may be one true cell joined through the undecided layer of joint space.
+certified counts or aspect splits (different basic components), or when one
+joint vector has a certified solution in each (Theorem 1).  The lower bound is
+the size of a set of regions pairwise different by these witnesses: the
+sheets of one cell per distinct aspect split (n_wa1, n_wa2), the rule the
+independent checker applies.  No upper bound is proved: two cells of equal
+split may be one true cell joined through the undecided layer of joint space.
 
 Proposition 1 is checked: above each counted cell and for each aspect, the
 number of sheets that hold certified boxes is compared with the certified
@@ -43,14 +44,10 @@ from intervalkin.paving.labels import signed_labels
 from intervalkin.paving.tree import Paving
 from intervalkin.space.aspect import ASPECTS, aspect_components
 from intervalkin.space.characteristic_surface import pave_regions
+from intervalkin.space.joint_route import JointGrid
 from intervalkin.space.joint_space import JointPaving
 from intervalkin.space.pieces import Witness, assign_sheets, certified_pieces
-from intervalkin.space.pose_label import (
-    PoseLabel,
-    boxes_holding,
-    label_from_boxes,
-    read_pose,
-)
+from intervalkin.space.pose_label import LabelledBoxes, PoseLabel, label_pose_in
 from intervalkin.space.uniqueness_domain import region_adjacency, uniqueness_domains
 
 __all__ = ['BasicRegion', 'RegionCounts', 'RegionAnalysis', 'analyse_regions', 'label_pose']
@@ -158,9 +155,9 @@ class RegionAnalysis:
             f"the {n_regions} regions found are the sheets above the {len({r.cell for r in self.regions})} joint "
             "cells that carry certified boxes (each cell's certified solve gives its number of sheets per "
             f"aspect); at least {lower} basic regions are pairwise certified distinct (opposite aspects, the "
-            "sheets of cells of different certified counts, distinct solutions of one joint vector)"
+            "sheets of cells of different certified aspect splits, distinct solutions of one joint vector)"
             + (", more than the regions found at this depth, so the bound is reported" if n_regions < lower else "")
-            + "; two cells of equal count are not proved to be different true cells, so the count is not proved "
+            + "; two cells of equal split are not proved to be different true cells, so the count is not proved "
             "exact")
         n_domains, bound = len(self.domains), self.domains_lower_bound
         placed = ("reaches this bound" if n_domains == bound else "exceeds it" if n_domains > bound else
@@ -224,13 +221,9 @@ def analyse_regions(geometry: Geometry, joint: JointPaving, depth: int, progress
     # certified lower bounds, from every cell with a certified count (whether or not the paving holds
     # certified boxes above it at this depth: its sheets exist all the same)
     solved = [c for c in joint.cells if c.count >= 0]
-    lower = 0  # per aspect, the sheets of one cell per distinct count: pairwise distinct
-    for name in ASPECTS:
-        best: dict[int, int] = {}
-        for cell in solved:
-            k = cell.n_wa1 if name == "WA1" else cell.n_wa2
-            best[cell.count] = max(best.get(cell.count, 0), k)
-        lower += sum(best.values())
+    # the sheets of one cell per distinct aspect split (n_wa1, n_wa2) are pairwise distinct: cells of different
+    # splits lie in different basic components; the rule the checker applies (checker.claims.count_bound)
+    lower = sum(n1 + n2 for n1, n2 in {(c.n_wa1, c.n_wa2) for c in solved})
     # the solutions of one joint vector in one aspect lie in different uniqueness domains
     bound = sum(max((c.n_wa1 if name == "WA1" else c.n_wa2 for c in solved), default=0) for name in ASPECTS)
 
@@ -257,15 +250,17 @@ def analyse_regions(geometry: Geometry, joint: JointPaving, depth: int, progress
                           time.perf_counter() - t0)
 
 
-def label_pose(analysis: RegionAnalysis, pose: Sequence) -> PoseLabel:
+def label_pose(analysis: RegionAnalysis, pose: Sequence, geometry: Geometry | None = None,
+               joint: JointPaving | None = None, refine: bool = True) -> PoseLabel:
     """Certified aspect, basic region and uniqueness domain of an exact pose (x, y, phi).
 
-    The pose is read exactly (decimal text, ints or Fractions; phi in radians in
-    [-pi, pi], not reduced modulo 2 pi); every box of the paving that contains it
-    is consulted (:mod:`intervalkin.space.pose_label`).
+    The pose is read exactly (decimal text, ints or Fractions; phi in radians,
+    reduced modulo 2 pi); every box of the paving that holds it is consulted,
+    and with ``geometry`` the pose itself and a certified path to a labelled box
+    (guided by the cells of ``joint``; skipped when ``refine`` is False) decide
+    what the boxes leave open (:mod:`intervalkin.space.pose_label`).
     """
-    exact = read_pose(pose)
     p = analysis.paving
-    idx = boxes_holding(p.lo, p.hi, exact)
-    return label_from_boxes(exact, signed_labels(p.labels["W"][idx]), signed_labels(p.labels["det_positive"][idx]),
-                            analysis.region[idx], analysis.domain[idx])
+    boxes = LabelledBoxes(p.lo, p.hi, p.domain, signed_labels(p.labels["W"]), signed_labels(p.labels["det_positive"]),
+                          analysis.region, analysis.domain)
+    return label_pose_in(boxes, pose, geometry, None if joint is None else JointGrid.of_paving(joint), refine)

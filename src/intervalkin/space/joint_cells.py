@@ -186,24 +186,23 @@ def regions_from_cells(cells: Sequence[JointSpaceCell], proved_lower: int = 0) -
     solutions, each aspect holds exactly that many basic regions (Theorem 1 and
     Proposition 1 of the paper; proofs/lemma-theorem1-distinctness.md).  The count
     found is the sum of the cells' counts, over EVERY cell, whether or not a
-    workspace box lands in it.  Proved: cells of different signatures lie in
-    different components, so the sum over the distinct signatures is a lower bound
-    (raised to ``proved_lower`` when another argument proves more).  Not proved: that
+    workspace box lands in it.  The lower bound is ``proved_lower``, the bound the
+    certificates back (cells of different signatures lie in different components,
+    so the sum over the distinct signatures is a bound too, but its witnesses are
+    not yet written as certificate claims, so it is not declared).  Not proved: that
     two cells of one signature are different components, or that no cell is hidden
     in the undecided boxes; no upper bound.
     """
     known = [c for c in cells if c.count >= 0]
     found = sum(c.count for c in known)
-    distinct = sum(sig[0] for sig in {c.signature for c in known})
-    lower = max(distinct, proved_lower)
+    lower = proved_lower
     unknown = len(cells) - len(known)
     tally = ", ".join(f"{n} with {k}" for k, n in sorted(_tally(known).items())) or "none"
     return Count(
         max(found, lower), lower, None, False,
         f"the sum of the certified solution counts of the {len(known)} cells of the direct joint paving "
-        f"(cells by solutions: {tally}); at least {lower} are "
-        "proved: cells of different count or aspect split are different components of the joint box minus "
-        "g(S), each carrying its count of basic regions; two cells of one signature may still be one component "
+        f"(cells by solutions: {tally}); at least {lower} are proved by the certified witnesses (distinct "
+        "solutions and aspect splits, Theorem 1); two cells of one signature may still be one component "
         "joined through undecided boxes, and small cells may hide in them, so no upper bound is proved"
         + (f"; {unknown} cells whose solve did not complete are not counted" if unknown else ""))
 

@@ -1,0 +1,115 @@
+"""Counts against their proofs: the numbers a run printed must not contradict its certificates.
+
+A ``counts`` claim carries the library's number ``found`` beside its declared
+``lower_bound``; the checker recomputes the lower bound the verified claims
+prove (:func:`~intervalkin.checker.claims.count_bound`).  Whatever the run
+printed, these must hold, and :func:`check_found` refuses the claim otherwise:
+
+* ``lower_bound <= proved`` (the declared bound is backed; checked in ``claims``);
+* ``found >= proved``: a number of pieces found below a proved minimum is a
+  contradiction (the pieces were miscounted, or a proof is wrong), never a
+  result to print.
+
+When the certificate folder sits in an output folder (``DIR/certificates``
+beside ``DIR/summary.json``), the summary is what the user read, so
+:func:`check_summary_block` compares each count block with the claim: the same
+``count`` and ``lower_bound``, ``count >= lower_bound``, an ``upper_bound``
+(when one is given) not below them, and ``exact`` only when the two bounds meet.
+A summary of a run that did not complete (``"complete": false``) is not
+compared, and the verdict says so.
+
+Standard library only (the checker's trusted base).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from intervalkin.checker.parse import Refused
+
+__all__ = ['SUMMARY', 'read_summary', 'check_found', 'check_summary_block']
+
+#: The summary file of an output folder, beside its ``certificates/`` folder.
+SUMMARY = "summary.json"
+
+
+def read_summary(certificate_folder: str | Path) -> dict | None:
+    """The summary.json of the output folder holding ``certificate_folder``, or None.
+
+    Only a folder named ``certificates`` has one (``DIR/certificates`` and
+    ``DIR/summary.json``).  A summary that exists but cannot be read as a JSON
+    object is returned as ``{"unreadable": reason}``: every count claim then
+    fails, since what the user was shown cannot be matched with the proofs.
+    """
+    root = Path(certificate_folder)
+    if root.name != "certificates":
+        return None
+    path = root.parent / SUMMARY
+    if not path.is_file():
+        return None
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        return {"unreadable": f"{SUMMARY} cannot be read ({exc})"}
+    if not isinstance(doc, dict):
+        return {"unreadable": f"{SUMMARY} is not a JSON object"}
+    return doc
+
+
+def _count(v: Any, what: str) -> int:
+    if isinstance(v, bool) or not isinstance(v, int) or v < 0:
+        raise Refused(f"{what}: expected a non-negative integer, got {v!r}")
+    return v
+
+
+def check_found(name: str, found: Any, proved: int) -> None:
+    """Refuse a claim whose library count ``found`` is below the lower bound ``proved`` by the verified claims."""
+    if found is None:
+        return
+    found = _count(found, "found")
+    if found < proved:
+        raise Refused(f"the library found {found} {name.replace('_', ' ')}, below the {proved} that the verified "
+                      "claims prove: the count contradicts its certificates")
+
+
+def check_summary_block(name: str, claim: dict, proved: int, summary: dict | None) -> str:
+    """Compare the ``name`` block of summary.json with its counts claim; the text to add to the verdict.
+
+    Raises :class:`Refused` on a contradiction.  Returns "" when there is no
+    summary to compare with.
+    """
+    if summary is None:
+        return ""
+    if "unreadable" in summary:
+        raise Refused(str(summary["unreadable"]))
+    if summary.get("complete") is False:
+        return f"; {SUMMARY} not compared: its run did not complete"
+    block = summary.get(name)
+    if not isinstance(block, dict):
+        raise Refused(f"{SUMMARY} has no {name!r} block to compare with the claim")
+    count = _count(block.get("count"), f"{SUMMARY} {name}.count")
+    lower = _count(block.get("lower_bound"), f"{SUMMARY} {name}.lower_bound")
+    upper = block.get("upper_bound")
+    if upper is not None:
+        upper = _count(upper, f"{SUMMARY} {name}.upper_bound")
+    exact = block.get("exact")
+    problems = []
+    if claim.get("found") is not None and count != claim.get("found"):
+        problems.append(f"count {count} but the claim says {claim.get('found')} found")
+    if lower != claim.get("lower_bound"):
+        problems.append(f"lower_bound {lower} but the claim declares {claim.get('lower_bound')}")
+    if count < lower:
+        problems.append(f"count {count} below its own lower_bound {lower}")
+    if count < proved:
+        problems.append(f"count {count} below the {proved} the verified claims prove")
+    if upper is not None and (upper < count or upper < proved):
+        problems.append(f"upper_bound {upper} below the count {count} or the proved {proved}")
+    if exact is not (upper is not None and upper == lower):
+        problems.append(f"exact is {exact!r} with bounds {lower}..{upper}")
+    elif exact:
+        problems.append("exact, but the certificates prove no upper bound")
+    if problems:
+        raise Refused(f"{SUMMARY} contradicts the certificates on {name}: " + "; ".join(problems))
+    return f"; {SUMMARY} agrees (count {count}, lower bound {lower})"
