@@ -26,7 +26,6 @@ import numpy as np
 
 from intervalkin.core.geometry import default_geometry
 from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
-from intervalkin.paving.labels import Label
 from intervalkin.paving.adjacency import shares_face
 from intervalkin.space.aspect import aspect_components
 from intervalkin.paving.predicates import pave_workspace
@@ -143,7 +142,7 @@ def main():
     a = ap.parse_args()
     g = default_geometry()
     mc = monte_carlo(g)
-    print(f"Monte Carlo reference volumes (4e6 samples, float, seed 12345): "
+    print("Monte Carlo reference volumes (4e6 samples, float, seed 12345): "
           + ", ".join(f"{k} {v:.1f}" for k, v in mc.items()))
     depths = list(range(a.min_depth, a.max_depth + 1)) + ([9] if a.with_9 and a.max_depth < 9 else [])
     rows = []

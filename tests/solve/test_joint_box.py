@@ -28,6 +28,8 @@ from intervalkin.kinematics.constants import constants
 from intervalkin.kinematics.enclosures import rho_interval
 from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics, det_a_arb
 from intervalkin.solve.dkp import solve
+
+from tests.solve.shared import box_across_singular_image, concurrent_legs_box
 from intervalkin.solve.joint_box import clear_boxes, initial_cells, live_cells
 
 DATA = Path(__file__).parents[1] / "data"
@@ -108,32 +110,13 @@ def test_boxes_on_the_singular_image_are_never_clear(x, phi, width):
 
 def test_boxes_across_the_singular_image_are_not_clear(paper_geometry):
     """A box holding a point of g(S) found by exact bisection between two counts is refused."""
-    a = [Fraction(20), Fraction(20), Fraction(20)]
-    b = [Fraction(14), Fraction(26), Fraction(30)]
-    ca, cb = _split(solve(paper_geometry, a)), _split(solve(paper_geometry, b))
-    assert ca != cb
-    lo_t, hi_t = Fraction(0), Fraction(1)
-    while hi_t - lo_t > Fraction(1, 20000):
-        mid = (lo_t + hi_t) / 2
-        p = [u + mid * (v - u) for u, v in zip(a, b)]
-        res = solve(paper_geometry, p)
-        if res.complete and _split(res) == ca:
-            lo_t = mid
-        else:
-            hi_t = mid
-    pa = [float(u + lo_t * (v - u)) for u, v in zip(a, b)]
-    pb = [float(u + hi_t * (v - u)) for u, v in zip(a, b)]
-    box = np.array([[min(x, y) - 1e-4, max(x, y) + 1e-4] for x, y in zip(pa, pb)])[None]
-    assert not clear_boxes(paper_geometry, box)[0]
+    assert not clear_boxes(paper_geometry, box_across_singular_image(paper_geometry))[0]
 
 
 @pytest.mark.parametrize("width", [1e-2, 1e-4])
 def test_double_root_of_concurrent_legs_is_not_clear(width):
     g = load_geometry(DATA / "concurrent_legs.toml")
-    q = np.array([15.0, 13.0, 10.0])
-    box = np.stack([q - width, q + width], axis=-1)[None]
-    box[0, 2, 0] = 10.0  # stay inside the limits
-    assert not clear_boxes(g, box)[0]
+    assert not clear_boxes(g, concurrent_legs_box(width))[0]
 
 
 def _shared_orientation(geometry) -> float:
