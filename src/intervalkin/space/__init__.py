@@ -10,5 +10,6 @@ pieces, sheets, voxel_paths   pieces of certified boxes and the sheet above a ce
 basic_region            basic regions and basic components (Theorem 1, Proposition 1)
 uniqueness_domain       uniqueness domains (Theorem 2)
 pose_label              the certified labels of one exact pose
+pose_path, joint_route  a pose's basic region by a certified path into a labelled box (routes through joint cells)
 segment, path_search, trajectory, trajectory_result   certified non-singular trajectories
 """
