@@ -25,8 +25,12 @@ Nothing here prints: the stages are reported to an optional ``progress`` callbac
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import multiprocessing
+import os
 import time
+from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
 from fractions import Fraction
@@ -63,6 +67,9 @@ __all__ = ["DEFAULT_DEPTH", "MAX_CHAIN_DEPTH", "ProgressEvent", "RefinementStep"
 DEFAULT_DEPTH = 8
 #: Deepest workspace depth of the chain (its singular layer is paved one level deeper).
 MAX_CHAIN_DEPTH = 9
+#: From this joint depth on, the direct joint paving runs in a second process, beside the
+#: regions paving (they are independent; the default run has two cores to use).
+PARALLEL_JOINT_DEPTH = 6
 
 
 @dataclass(frozen=True)
@@ -333,10 +340,21 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     dw, ds, dj = chain_depths(depth)
     stages = _Stages(progress)
     joint = _joint_space(geometry, ds, dj, stages)
-    with stages.stage(f"joint space paved directly (depth {dj}, {JOIN_LEVELS} join levels)") as levels:
-        cells = pave_joint_cells(geometry, dj, JOIN_LEVELS, progress=levels)
-    with stages.stage(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})") as levels:
-        regions = analyse_regions(geometry, joint, dw, progress=levels)
+    name = f"joint space paved directly (depth {dj}, {JOIN_LEVELS} join levels)"
+    with contextlib.ExitStack() as side:
+        future = None
+        if dj >= PARALLEL_JOINT_DEPTH and (os.cpu_count() or 1) > 1:
+            # the two pavings are independent: the joint one runs in a second process beside the regions
+            pool = side.enter_context(ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")))
+            future = pool.submit(pave_joint_cells, geometry, dj, JOIN_LEVELS)
+        else:
+            with stages.stage(name) as levels:
+                cells = pave_joint_cells(geometry, dj, JOIN_LEVELS, progress=levels)
+        with stages.stage(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})") as levels:
+            regions = analyse_regions(geometry, joint, dw, progress=levels)
+        if future is not None:
+            with stages.stage(name + ", in a second process: waiting for it"):
+                cells = future.result()
     history = [RefinementStep(dw, regions.consistent, len(regions.regions))]
     while refine_to is not None and not regions.consistent and dw < refine_to:
         dw += 1
