@@ -26,20 +26,18 @@ from hypothesis import strategies as st
 from intervalkin.core.geometry import default_geometry, load_geometry
 from intervalkin.kinematics.constants import constants
 from intervalkin.kinematics.enclosures import rho_interval
-from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics, det_a_arb
+from intervalkin.kinematics.formulas import (
+    approx_det_a,
+    approx_inverse_kinematics,
+    det_a_arb,
+)
 from intervalkin.solve.dkp import solve
-
-from tests.solve.shared import box_across_singular_image, concurrent_legs_box
 from intervalkin.solve.joint_box import clear_boxes, initial_cells, live_cells
+from tests.solve.shared import box_across_singular_image, concurrent_legs_box
+from tests.solve.shared import split_of as _split
 
 DATA = Path(__file__).parents[1] / "data"
 PAPER = default_geometry()
-
-
-def _split(result) -> tuple[int, int, int]:
-    assert result.complete, result.completeness_reason
-    wa1 = sum(1 for s in result.solutions if s.aspect == "WA1")
-    return result.count, wa1, result.count - wa1
 
 
 def _q(x: float) -> arb:

@@ -23,20 +23,18 @@ from hypothesis import strategies as st
 from intervalkin.core.ball import Ball, cos_sin_multiple
 from intervalkin.core.geometry import load_geometry
 from intervalkin.core.interval import Interval
-from intervalkin.kinematics.reduced_equation import HARMONICS, MONOMIALS, reduced_equation
+from intervalkin.kinematics.reduced_equation import (
+    HARMONICS,
+    MONOMIALS,
+    reduced_equation,
+)
 from intervalkin.kinematics.sextic import laurent_value, reduction
 from intervalkin.solve.dkp import solve
-
-from tests.solve.shared import box_across_singular_image, concurrent_legs_box
 from intervalkin.solve.simple_roots import initial_pieces, open_pieces
+from tests.solve.shared import box_across_singular_image, concurrent_legs_box
+from tests.solve.shared import split_of as _split
 
 DATA = Path(__file__).parents[1] / "data"
-
-
-def _split(result) -> tuple[int, int, int]:
-    assert result.complete, result.completeness_reason
-    wa1 = sum(1 for s in result.solutions if s.aspect == "WA1")
-    return result.count, wa1, result.count - wa1
 
 
 def _q(x: float) -> arb:
