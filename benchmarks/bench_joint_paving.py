@@ -32,7 +32,7 @@ def _agreement(geometry, jp, samples: int, seed: int) -> tuple[int, int, int, in
     dom = joint_domain(geometry)
     rng = np.random.default_rng(seed)
     q = dom[:, 0] + rng.random((samples, 3)) * (dom[:, 1] - dom[:, 0])
-    cell = jp.cell_of(q)
+    cell = jp.cell_of(q, geometry)
     by_id = {c.id: c for c in jp.cells}
     labelled = agree = wrong = 0
     for v, cid in zip(q, cell):

@@ -115,9 +115,15 @@ def joint_cells_summary(jp) -> dict:
         "undecided_volume": jp.undecided_volume(),
         "undecided_volume_per_level": [st["undecided_volume"]["clear"] for st in stats],
         "cells": [c.to_json() for c in jp.cells],
-        "certified": "every box of a cell is proved off g(S) (no singular pose has its joint vector in it); "
-                     "each cell's count and aspect split come from one complete certified solve at its witness "
-                     "and hold at every point of the cell; cells are not proved to be different components",
+        "fold_boxes": int(jp.fold_stats.get("fold_boxes", 0)),
+        "unjoined_fold_pieces": {"groups": int(jp.fold_stats.get("unjoined_piece_groups", 0)),
+                                 "volume": float(jp.fold_stats.get("unjoined_piece_volume", 0.0))},
+        "certified": "every box of a cell is proved off g(S) (no singular pose has its joint vector in it), or is "
+                     "a fold box: one sheet of g(S) crosses it as a certified graph and each of its two pieces is "
+                     "joined to the cell through a point placed in both; each cell's count and aspect split come "
+                     "from one complete certified solve at its witness and hold at every point of the cell; cells "
+                     "are not proved to be different components; fold pieces joined to no clear box are counted "
+                     "under unjoined_fold_pieces (their counts are not computed)",
     }
 
 

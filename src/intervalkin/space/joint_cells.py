@@ -18,11 +18,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import breadth_first_order
+from scipy.sparse.csgraph import breadth_first_order, connected_components
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.status import Count
@@ -30,6 +30,7 @@ from intervalkin.paving.adjacency import component_labels, shares_face
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 from intervalkin.solve.dkp import solve
+from intervalkin.space.joint_pieces import FoldPieces
 
 __all__ = ["JointSpaceCell", "CellSolver", "joining_paths", "regions_from_cells"]
 
@@ -84,6 +85,8 @@ class CellSolver:
         self.geometry = geometry
         self._solved: dict[int, tuple[tuple[int, int, int], tuple[Fraction, Fraction, Fraction]]] = {}
         self.edges: np.ndarray = np.zeros((2, 0), dtype=np.int64)
+        #: (groups, volume) of fold pieces joined to no clear box at the last labelling
+        self.unjoined: tuple[int, float] = (0, 0.0)
 
     def _signature(self, lo: np.ndarray, hi: np.ndarray):
         witness = _exact_centre(lo, hi)
@@ -93,11 +96,44 @@ class CellSolver:
             return (res.count, n1, res.count - n1), witness
         return (-1, -1, -1), witness
 
-    def label(self, paving: Paving, fine_depth: int) -> tuple[np.ndarray, list[JointSpaceCell]]:
-        """(cell id per box, -1 where undecided; the cells, largest first) of ``paving``."""
+    def label(self, paving: Paving, fine_depth: int,
+              pieces_of: Callable[[np.ndarray], FoldPieces | None] | None = None
+              ) -> tuple[np.ndarray, list[JointSpaceCell], FoldPieces | None, np.ndarray]:
+        """(cell id per box (-1 where undecided), the cells largest first, the fold pieces, cell id per piece).
+
+        ``pieces_of(face_edges)``, when given, returns the fold pieces of the paving's
+        undecided boxes (:mod:`intervalkin.space.joint_pieces`); their edges join clear
+        boxes and pieces into cells, and a cell with no clear box is solved at a
+        witness of one of its pieces.
+        """
         ok = paving.labels["clear"] == Label.INSIDE
+        n = len(paving)
         self.edges = shares_face(paving.level, paving.ijk, fine_depth, periodic=_NOWRAP)
-        comp = component_labels(len(paving), self.edges, ok)
+        pieces = pieces_of(self.edges) if pieces_of is not None else None
+        m2 = 2 * len(pieces) if pieces is not None else 0
+        if m2:
+            live = np.zeros(n + m2, dtype=bool)
+            live[:n] = ok
+            live[n:] = np.isfinite(pieces.witness).all(axis=1)
+            live[pieces.edges.ravel()] = True
+            both = ok[self.edges[0]] & ok[self.edges[1]]
+            e = np.concatenate([self.edges[:, both], pieces.edges], axis=1)
+            comp_all = _components(n + m2, e, live)
+        else:
+            comp_all = component_labels(n, self.edges, ok)
+        # a cell holds at least one clear box; pieces joined to none are reported, not counted
+        self.unjoined = (0, 0.0)
+        if m2:
+            has_clear = np.zeros(int(comp_all.max()) + 1, dtype=bool)
+            has_clear[comp_all[:n][ok]] = True
+            alone = (comp_all[n:] >= 0) & ~has_clear[np.maximum(comp_all[n:], 0)]
+            groups = np.unique(comp_all[n:][alone]).size
+            vol_p = np.repeat(paving.volume()[pieces.box], 2) / 2.0
+            self.unjoined = (int(groups), float(vol_p[alone].sum()))
+            remap = np.cumsum(has_clear) - 1
+            comp_all = np.where((comp_all >= 0) & has_clear[np.maximum(comp_all, 0)],
+                                remap[np.maximum(comp_all, 0)], -1)
+        comp, piece_comp = comp_all[:n], comp_all[n:]
         keys = _keys(paving.level, paving.ijk)
         known = np.flatnonzero(ok & np.isin(keys, np.fromiter(self._solved, dtype=np.int64, count=len(self._solved))))
         first: dict[int, int] = {}
@@ -109,9 +145,13 @@ class CellSolver:
             else:
                 first[c] = int(k)
         vol = paving.volume()
-        ncomp = int(comp.max()) + 1 if ok.any() else 0
+        ncomp = int(comp_all.max()) + 1 if (comp_all >= 0).any() else 0
         box_count = np.bincount(comp[ok], minlength=ncomp)
         comp_vol = np.bincount(comp[ok], weights=vol[ok], minlength=ncomp)
+        if m2:  # half a fold box to each of its pieces: a float measure for ordering and reports
+            pv = np.repeat(vol[pieces.box], 2) / 2.0
+            has = piece_comp >= 0
+            comp_vol += np.bincount(piece_comp[has], weights=pv[has], minlength=ncomp)
         order = np.argsort(-comp_vol, kind="stable")
         new_id = np.empty(ncomp, dtype=np.int64)
         new_id[order] = np.arange(ncomp)
@@ -119,9 +159,13 @@ class CellSolver:
         idx = np.flatnonzero(ok)
         by_size = idx[np.lexsort((idx, paving.level[idx], comp[idx]))]
         start = np.searchsorted(comp[by_size], np.arange(ncomp))
+        p_order = np.argsort(piece_comp, kind="stable")
+        p_start = np.searchsorted(piece_comp[p_order], np.arange(ncomp))
+        p_end = np.searchsorted(piece_comp[p_order], np.arange(ncomp), side="right")
         cells = []
         for c in order:
             c = int(c)
+            sig, witness = (-1, -1, -1), (Fraction(0), Fraction(0), Fraction(0))
             if c in first:
                 sig, witness = self._solved[int(keys[first[c]])]
             else:
@@ -131,10 +175,28 @@ class CellSolver:
                     if sig[0] >= 0:
                         self._solved[int(keys[b])] = (sig, witness)  # only proved signatures are reused
                         break
+                if sig[0] < 0 and m2:
+                    for w in pieces.witness[p_order[p_start[c]:p_end[c]]][:4 * _TRIES]:
+                        if np.isfinite(w).all():
+                            sig, witness = self._signature(w, w)
+                            if sig[0] >= 0:
+                                break
             cells.append(JointSpaceCell(int(new_id[c]), int(box_count[c]), float(comp_vol[c]), *sig, witness))
         cell = np.full(len(paving), -1, dtype=np.int32)
         cell[ok] = new_id[comp[ok]]
-        return cell, cells
+        piece_cell = np.where(piece_comp >= 0, new_id[np.maximum(piece_comp, 0)], -1).astype(np.int32)
+        return cell, cells, pieces, piece_cell
+
+
+def _components(n: int, edges: np.ndarray, live: np.ndarray) -> np.ndarray:
+    """(n,) component id of each live node under ``edges`` (ids 0..c-1 by first node), -1 elsewhere."""
+    keep = live[edges[0]] & live[edges[1]]
+    g = csr_matrix((np.ones(int(keep.sum())), (edges[0, keep], edges[1, keep])), shape=(n, n))
+    _, lab = connected_components(g, directed=False)
+    out = np.full(n, -1, dtype=np.int64)
+    ids, first = np.unique(lab[live], return_inverse=True)
+    out[live] = first
+    return out
 
 
 def joining_paths(edges: np.ndarray, cell: np.ndarray, cells: list[JointSpaceCell]) -> np.ndarray:

@@ -40,8 +40,10 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.paving.budget import check_depth
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving, box_bounds, split_boxes
+from intervalkin.solve.fold_model import fold_models, pose_hulls, side_of
 from intervalkin.solve.joint_box import initial_cells, live_cells
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
+from intervalkin.space.joint_pieces import FoldPieces, fold_pieces
 
 __all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain", "DEFAULT_JOINT_DEPTH", "JOIN_LEVELS"]
 
@@ -66,31 +68,68 @@ class JointSpacePaving:
     paving: Paving
     cell: np.ndarray
     cells: tuple[JointSpaceCell, ...]
+    pieces: FoldPieces | None = None
+    piece_cell: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int32))
+    fold_stats: dict = field(default_factory=dict)
+
+    def counted_fold_mask(self) -> np.ndarray:
+        """(n,) bool: the leaves that are fold boxes whose two pieces both lie in cells of known count."""
+        out = np.zeros(len(self.cell), dtype=bool)
+        if self.pieces is not None and len(self.pieces):
+            known = np.array([c.count >= 0 for c in self.cells] + [False], dtype=bool)
+            pc = self.piece_cell.reshape(-1, 2)
+            out[self.pieces.box] = known[pc[:, 0]] & known[pc[:, 1]]
+        return out
 
     def undecided_volume(self) -> float:
-        return float(self.paving.volume()[self.cell < 0].sum())
+        """Volume of the leaves that are neither clear nor fold boxes with both pieces counted."""
+        return float(self.paving.volume()[(self.cell < 0) & ~self.counted_fold_mask()].sum())
 
     def certified_share(self) -> float:
+        """Share of the joint box whose count is certified: clear boxes and fold boxes (both pieces counted)."""
         v = self.paving.volume()
-        return float(v[self.cell >= 0].sum() / v.sum())
+        return float(v[(self.cell >= 0) | self.counted_fold_mask()].sum() / v.sum())
 
-    def cell_of(self, rho: np.ndarray) -> np.ndarray:
+    def cell_of(self, rho: np.ndarray, geometry: Geometry | None = None) -> np.ndarray:
         """Cell id (m,) of each joint box or point rho (m, 3, 2) or (m, 3): the cell of the leaf that
-        contains it entirely, -1 when that leaf is undecided or no single leaf contains it."""
+        contains it entirely, -1 when that leaf is undecided or no single leaf contains it.
+
+        With ``geometry``, a point in a fold box is placed in one of its two pieces by the
+        side test (:func:`intervalkin.solve.fold_model.side_of`) and gets that piece's cell.
+        """
         q = np.asarray(rho, dtype=np.float64)
         boxes = np.stack([q, q], axis=-1) if q.ndim == 2 else q
         leaf = self.paving.locate_boxes(boxes)
-        return np.where(leaf >= 0, self.cell[np.maximum(leaf, 0)], -1)
+        out = np.where(leaf >= 0, self.cell[np.maximum(leaf, 0)], -1)
+        if geometry is None or q.ndim != 2 or self.pieces is None or not len(self.pieces):
+            return out
+        row = np.full(len(self.cell), -1, dtype=np.int64)
+        row[self.pieces.box] = np.arange(len(self.pieces))
+        t = np.where(leaf >= 0, row[np.maximum(leaf, 0)], -1)
+        at = np.flatnonzero((out < 0) & (t >= 0))
+        if at.size:
+            side = side_of(geometry, self.pieces.models, t[at], q[at])
+            pc = self.piece_cell.reshape(-1, 2)[t[at], (side > 0).astype(np.int64)]
+            out[at] = np.where(side != 0, pc, -1)
+        return out
 
     def columns(self) -> dict[str, np.ndarray]:
-        """npz columns: lo, hi, level, cell id, count, n_wa1, n_wa2 (-1 where undecided)."""
+        """npz columns: lo, hi, level, cell id, count, n_wa1, n_wa2 (-1 where undecided); and for fold
+        boxes: fold_axis (the axis k of the sheet, -1 elsewhere), cell_below and cell_above (the cells of
+        the pieces q_k < h and q_k > h, -1 elsewhere or unknown)."""
         count = np.full(len(self.cell), -1, dtype=np.int32)
         wa1, wa2 = count.copy(), count.copy()
         for c in self.cells:
             m = self.cell == c.id
             count[m], wa1[m], wa2[m] = c.count, c.n_wa1, c.n_wa2
+        axis, below, above = count.copy(), count.copy(), count.copy()
+        if self.pieces is not None and len(self.pieces):
+            pc = self.piece_cell.reshape(-1, 2)
+            axis[self.pieces.box] = self.pieces.models.axis
+            below[self.pieces.box], above[self.pieces.box] = pc[:, 0], pc[:, 1]
         return {"lo": self.paving.lo, "hi": self.paving.hi, "level": self.paving.level.astype(np.int32),
-                "cell": self.cell.astype(np.int32), "count": count, "n_wa1": wa1, "n_wa2": wa2}
+                "cell": self.cell.astype(np.int32), "count": count, "n_wa1": wa1, "n_wa2": wa2,
+                "fold_axis": axis, "cell_below": below, "cell_above": above}
 
 
 def joint_domain(geometry: Geometry) -> np.ndarray:
@@ -183,7 +222,7 @@ def _to_paving(domain: np.ndarray, leaves: tuple[np.ndarray, ...], stats: list[d
 
 
 def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_levels: int = JOIN_LEVELS,
-                     progress: Callable[[dict], None] | None = None) -> JointSpacePaving:
+                     progress: Callable[[dict], None] | None = None, fold: bool = True) -> JointSpacePaving:
     """Pave the joint box to ``depth`` with the clear-box test, join cells across walls, and count them.
 
     Parameters
@@ -192,6 +231,8 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         range / 2**depth); 1..11, memory checked before any work.
     join_levels : further levels, only in undecided boxes that separate two cells of
         equal count and split (0: no joins).
+    fold : give the undecided leaves fold models (:mod:`intervalkin.solve.fold_model`) where
+        they can be proved; their pieces join the cells and count as certified volume.
 
     Cost: the undecided boxes lie along the 2-D surface g(S), so their number grows
     like 4**depth; each cell costs one certified solve.
@@ -203,9 +244,10 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     found_leaves, stats = _adaptive(geometry, domain, depth, progress)
     leaves = found_leaves.merge()
     cells = CellSolver(geometry)
+    store = _FoldStore(geometry) if fold else None
     for extra in range(join_levels + 1):
         paving = _to_paving(domain, leaves, stats)
-        cell, found = cells.label(paving, depth + join_levels)
+        cell, found, _, _ = cells.label(paving, depth + join_levels)
         if extra == join_levels:
             break
         wall = joining_paths(cells.edges, cell, found) & (paving.level < depth + join_levels)
@@ -215,7 +257,18 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         if not np.any(wall):
             break
         leaves = _refine(geometry, domain, leaves, wall)
-    return JointSpacePaving(paving, cell, tuple(found))
+    pieces, piece_cell, fold_stats = None, np.zeros(0, dtype=np.int32), {}
+    if fold:
+        t0 = time.perf_counter()
+        store = _FoldStore(geometry)
+        cell, found, pieces, piece_cell = cells.label(paving, depth + join_levels, lambda e: store.pieces(leaves, e))
+        unjoined = cells.unjoined
+        fold_stats = {"fold_boxes": 0 if pieces is None else len(pieces), "seconds": time.perf_counter() - t0,
+                      "unjoined_piece_groups": unjoined[0], "unjoined_piece_volume": unjoined[1]}
+        if progress is not None:
+            progress({"stage": "fold models", "level": depth + join_levels, "depth": depth + join_levels,
+                      "boxes": fold_stats["fold_boxes"], "split": 0, "cells": len(found)})
+    return JointSpacePaving(paving, cell, tuple(found), pieces, piece_cell, fold_stats)
 
 
 def _refine(geometry: Geometry, domain: np.ndarray, leaves: tuple[np.ndarray, ...], wall: np.ndarray):
@@ -233,3 +286,47 @@ def _refine(geometry: Geometry, domain: np.ndarray, leaves: tuple[np.ndarray, ..
     out.parts.append((level[keep], ijk[keep], lo[keep], hi[keep], clear[keep], pos[owner[~sel]], cells[~sel]))
     out.add(front, clo, chi, cclear, np.ones(len(cclear), dtype=bool))
     return out.merge()
+
+
+def _leaf_keys(level: np.ndarray, ijk: np.ndarray) -> np.ndarray:
+    ijk = np.asarray(ijk, dtype=np.int64)
+    return (np.asarray(level, dtype=np.int64) << 48) | (ijk[:, 0] << 32) | (ijk[:, 1] << 16) | ijk[:, 2]
+
+
+class _FoldStore:
+    """Fold models of undecided leaves, computed once per leaf (joins re-label the paving several times)."""
+
+    def __init__(self, geometry: Geometry):
+        self.geometry = geometry
+        self.keys = np.zeros(0, dtype=np.int64)
+        self.models = None
+
+    def _update(self, leaves: tuple[np.ndarray, ...]) -> np.ndarray:
+        """Row of each undecided leaf in the store (-1: no model), computing the new ones."""
+        level, ijk, lo, hi, clear, owner, cells = leaves
+        und = np.flatnonzero(~clear)
+        keys = _leaf_keys(level[und], ijk[und])
+        new = ~np.isin(keys, self.keys)
+        if new.any():
+            fresh = und[new]
+            pos = np.full(len(level), -1)
+            pos[fresh] = np.arange(fresh.size)
+            sel = pos[owner] >= 0
+            boxes = np.stack([lo[fresh], hi[fresh]], axis=-1)
+            hulls = pose_hulls(self.geometry, boxes, pos[owner[sel]], cells[sel])
+            m = fold_models(self.geometry, boxes, hulls)
+            self.models = m if self.models is None else self.models.concat(m)
+            self.keys = np.concatenate([self.keys, keys[new]])
+        order = np.argsort(self.keys, kind="stable")
+        at = order[np.searchsorted(self.keys[order], keys)]
+        row = np.full(len(level), -1, dtype=np.int64)
+        row[und] = np.where(self.models.ok[at], at, -1)
+        return row
+
+    def pieces(self, leaves: tuple[np.ndarray, ...], face_edges: np.ndarray) -> FoldPieces | None:
+        row = self._update(leaves)
+        box = np.flatnonzero(row >= 0)
+        if box.size == 0:
+            return None
+        level, ijk, lo, hi, clear = leaves[:5]
+        return fold_pieces(self.geometry, lo, hi, clear, face_edges, box, self.models.take(row[box]))

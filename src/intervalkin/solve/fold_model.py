@@ -1,0 +1,315 @@
+"""Fold models of joint boxes: one sheet of g(S) as a certified graph, cutting the box in two.
+
+The claim
+---------
+Let R = R_1 x R_2 x R_3 be a joint box that is not clear (:mod:`intervalkin.solve.joint_box`),
+k one of its axes and (i, j) the other two.  Every singular pose X with g(X) in R lies
+in the pose boxes of the torus cells that the clear-box search left live; let X be a
+pose box holding all of them.  Consider, for p = (r_i, r_j) in R_i x R_j, the system
+
+    E(X; p) = ( rho_i^2(X) - r_i^2,  rho_j^2(X) - r_j^2,  det A(X) ) = 0
+
+(the singular poses of the four-bar with legs i and j of lengths r_i, r_j).  If the
+parametric Krawczyk operator
+
+    K = m - Y E(m; R_i x R_j) + (I - Y E'(X)) (X - m)        (E' does not depend on p)
+
+lies in the interior of X, then for EVERY p the system has exactly one zero X*(p) in X,
+every matrix of E'(X) is regular, and X*(p) is C^1 in p (implicit function theorem).
+So on every line of R parallel to axis k there is at most one point of g(S), at
+h(p) = rho_k(X*(p)): g(S) meets R in the graph of a continuous function, and R minus
+g(S) is the union of B = {q_k < h} and T = {q_k > h}.  B and T are each connected (or
+empty) when either
+
+* the enclosure of h over R_i x R_j (rho_k over K) lies strictly inside R_k (then B
+  holds the face q_k = lo and T the face q_k = hi, and every point joins its face along
+  a line parallel to axis k), or
+* dh/dr_i and dh/dr_j have certified signs: the normal of g(S) at g(X), X singular, is
+  (rho_1 w_1, rho_2 w_2, rho_3 w_3) with w = (u_2 x u_3, u_3 x u_1, u_1 x u_2) and
+  u_l = B_l - A_l (the left null vector of A), so dh/dr_i = -rho_i w_i / (rho_k w_k);
+  signs of w_i, w_j, w_k certified on K give them.  Then B is monotone towards one corner
+  of R_i x R_j, and every point of B joins the line over that corner (nested
+  monotonicity), which meets B in one segment; the same for T.
+
+The two pieces have different counts (X*(p) is a fold point of g: E' regular means the
+kernel of A is transverse to S), and a point q of R off g(S) is placed in B or T by a
+Krawczyk step at the point parameter (q_i, q_j) (:func:`side_of`).
+See proofs/lemma-fold-joint-box.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import PI_HI, PI_LO, Interval
+from intervalkin.kinematics.constants import constants
+from intervalkin.kinematics.enclosures import (det_a_gradient_interval, det_a_interval, jacobian_interval,
+                                               rho_sq_interval)
+
+__all__ = ["FoldModels", "fold_models", "side_of", "pose_hulls"]
+
+#: Epsilon-inflation rounds of the Krawczyk box before a model is given up.
+INFLATE_ROUNDS = 2
+#: Krawczyk steps of the side test (each one shrinks the enclosure of X*(q) by about the norm of C).
+SIDE_STEPS = 4
+_CHUNK = 32768
+
+
+@dataclass(frozen=True, eq=False)
+class FoldModels:
+    """Fold models of n joint boxes (entries where ``ok`` is False carry no claim).
+
+    ok : (n,) bool, a model is proved for the box.
+    axis : (n,) int8, the axis k along which g(S) is a graph (-1: no model).
+    pose : (n, 3, 2) the Krawczyk box X (holds every singular pose with g(X) in the box,
+        and exactly one zero X*(p) for each p).
+    height : Interval (n,), an enclosure of h = rho_k(X*(p)) over all p.
+    inv : (n, 3, 3) the float preconditioner Y of the proof (reused by the side test).
+    contraction : Interval (n, 3, 3), C = I - Y E'(X) over the pose box (reused by the side test).
+    """
+
+    ok: np.ndarray
+    axis: np.ndarray
+    pose: np.ndarray
+    height: Interval
+    inv: np.ndarray
+    contraction: Interval
+
+    def __len__(self) -> int:
+        return len(self.ok)
+
+    def take(self, rows: np.ndarray) -> "FoldModels":
+        """The models of the given rows, in that order."""
+        return FoldModels(self.ok[rows], self.axis[rows], self.pose[rows], self.height[rows], self.inv[rows],
+                          self.contraction[rows])
+
+    def concat(self, other: "FoldModels") -> "FoldModels":
+        def cat(a, b):
+            return np.concatenate([a, b])
+        return FoldModels(cat(self.ok, other.ok), cat(self.axis, other.axis), cat(self.pose, other.pose),
+                          Interval(cat(self.height.lo, other.height.lo), cat(self.height.hi, other.height.hi)),
+                          cat(self.inv, other.inv),
+                          Interval(cat(self.contraction.lo, other.contraction.lo),
+                                   cat(self.contraction.hi, other.contraction.hi)))
+
+
+def pose_hulls(geometry: Geometry, joint_boxes: np.ndarray, owner: np.ndarray, cells: np.ndarray):
+    """Per joint box, the hull of the pose boxes of its live torus cells: (n, 3, 2), NaN where none.
+
+    A cluster that straddles the phi seam is shifted by 2 pi (every quantity is
+    2 pi-periodic in phi), so the hull stays narrow where it can.
+    """
+    n = len(joint_boxes)
+    out = np.full((n, 3, 2), np.nan)
+    if owner.size == 0:
+        return out
+    k = constants(geometry)
+    r1 = Interval(joint_boxes[owner, 0, 0], joint_boxes[owner, 0, 1])
+    th = Interval(cells[:, 0], cells[:, 1])
+    x, y = r1 * th.cos() + k.ax_iv[0], r1 * th.sin() + k.ay_iv[0]
+    plo, phi_hi = cells[:, 2].copy(), cells[:, 3].copy()
+    starts = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+    who = owner[starts]
+
+    def hull(lo, hi):
+        return np.minimum.reduceat(lo, starts), np.maximum.reduceat(hi, starts)
+
+    wide = np.zeros(n, dtype=bool)
+    a, b = hull(plo, phi_hi)
+    wide[who] = b - a > np.pi
+    shift = wide[owner] & (phi_hi <= 0.0)
+    # phi + 2 pi for the cells below the seam, rounded outward (2 pi itself is only enclosed)
+    moved = Interval(plo[shift], phi_hi[shift]) + Interval.from_bounds(2.0 * PI_LO, 2.0 * PI_HI)
+    plo[shift], phi_hi[shift] = moved.lo, moved.hi
+    for ax, (lo, hi) in enumerate(((x.lo, x.hi), (y.lo, y.hi), (plo, phi_hi))):
+        a, b = hull(lo, hi)
+        out[who, ax, 0], out[who, ax, 1] = a, b
+    return out
+
+
+def _rows(geometry: Geometry, X: np.ndarray, k: int) -> Interval:
+    """E'(X): the rows grad rho_i^2, grad rho_j^2, grad det A over the pose boxes, (n, 3, 3)."""
+    i, j = [a for a in range(3) if a != k]
+    A = jacobian_interval(geometry, X)
+    G = det_a_gradient_interval(geometry, X)
+    return Interval(np.stack([A.lo[:, i], A.lo[:, j], G.lo], 1), np.stack([A.hi[:, i], A.hi[:, j], G.hi], 1))
+
+
+def _residual(geometry: Geometry, m: np.ndarray, k: int, P: Interval) -> Interval:
+    """E(m; P) at float poses m (n, 3) for parameter boxes P (n, 2) of (r_i, r_j)."""
+    pts = np.stack([m, m], axis=-1)
+    e = rho_sq_interval(geometry, pts)
+    i, j = [a for a in range(3) if a != k]
+    d = det_a_interval(geometry, pts)
+    Pi, Pj = P[:, 0].sqr(), P[:, 1].sqr()
+    ri, rj = e[:, i] - Pi, e[:, j] - Pj
+    return Interval(np.stack([ri.lo, rj.lo, d.lo], 1), np.stack([ri.hi, rj.hi, d.hi], 1))
+
+
+def _preconditioned(geometry: Geometry, X: np.ndarray, k: int) -> tuple[np.ndarray, Interval]:
+    """(Y, C): Y = mid(E'(X))^-1 (NaN where singular) and C = I - Y E'(X) (interval), over pose boxes X."""
+    J = _rows(geometry, X, k)
+    with np.errstate(all="ignore"):
+        M = 0.5 * (J.lo + J.hi)
+        ok = np.isfinite(M).all(axis=(1, 2)) & (np.abs(np.linalg.det(np.where(np.isfinite(M), M, 0.0))) > 1e-300)
+        Y = np.full(M.shape, np.nan)
+        if ok.any():
+            Y[ok] = np.linalg.inv(M[ok])
+    C_lo, C_hi = np.empty(M.shape), np.empty(M.shape)
+    for a in range(3):
+        for b in range(3):
+            c = Interval.point(np.full(len(X), 1.0 if a == b else 0.0))
+            for d in range(3):
+                c = c - J[:, d, b] * Y[:, a, d]
+            C_lo[:, a, b], C_hi[:, a, b] = c.lo, c.hi
+    return Y, Interval(C_lo, C_hi)
+
+
+def _krawczyk(geometry: Geometry, X: np.ndarray, k: int, P: Interval, Y: np.ndarray, C: Interval) -> np.ndarray:
+    """The Krawczyk image (n, 3, 2) of pose boxes X for parameters P, with Y and C = I - Y E'(X') for X' containing X.
+
+    Any C computed over a box containing X is sound (the mean value theorem only needs
+    an enclosure of E' over X), so a side test reuses the C of its model's proof.
+    """
+    Xi = Interval(X[:, :, 0], X[:, :, 1])
+    m = Xi.mid()
+    F = _residual(geometry, m, k, P)
+    D = Xi - m
+    K_lo, K_hi = np.empty(m.shape), np.empty(m.shape)
+    for a in range(3):
+        acc = Interval.point(m[:, a])
+        for b in range(3):
+            acc = acc - F[:, b] * Y[:, a, b] + C[:, a, b] * D[:, b]
+        K_lo[:, a], K_hi[:, a] = acc.lo, acc.hi
+    K = np.stack([K_lo, K_hi], axis=-1)
+    K[~np.isfinite(K).all(axis=(1, 2))] = np.nan
+    return K
+
+
+def _inside(K: np.ndarray, X: np.ndarray) -> np.ndarray:
+    with np.errstate(invalid="ignore"):
+        return ((K[:, :, 0] > X[:, :, 0]) & (K[:, :, 1] < X[:, :, 1])).all(axis=1)
+
+
+def _cross(ax, ay, bx, by):
+    return ax * by - ay * bx
+
+
+def _normal_signs(geometry: Geometry, K: np.ndarray) -> np.ndarray:
+    """(n, 3) int8: certified signs of w_l = u_m x u_n over the pose boxes (0: not proved)."""
+    A = jacobian_interval(geometry, K)  # row l is 2 (u_lx, u_ly, r_l x u_l)
+    u = [(A[:, l, 0], A[:, l, 1]) for l in range(3)]
+    out = np.zeros((len(K), 3), dtype=np.int8)
+    for l in range(3):
+        m, n = (l + 1) % 3, (l + 2) % 3
+        w = _cross(u[m][0], u[m][1], u[n][0], u[n][1])
+        out[:, l] = np.where(w.lo > 0, 1, np.where(w.hi < 0, -1, 0))
+    return out
+
+
+def fold_models(geometry: Geometry, joint_boxes: np.ndarray, hulls: np.ndarray) -> FoldModels:
+    """Fold models of joint boxes (n, 3, 2) whose singular poses lie in ``hulls`` (n, 3, 2), if provable.
+
+    Each axis k is tried; a model is kept when the Krawczyk box of the singular
+    four-bar system is proved (module docstring) and one of the two connectivity
+    conditions holds.  Certified where ``ok``; no claim elsewhere.
+    """
+    n = len(joint_boxes)
+    ok = np.zeros(n, dtype=bool)
+    axis = np.full(n, -1, dtype=np.int8)
+    pose = np.full((n, 3, 2), np.nan)
+    height = Interval(np.full(n, np.nan), np.full(n, np.nan))
+    inv = np.full((n, 3, 3), np.nan)
+    contraction = Interval(np.full((n, 3, 3), np.nan), np.full((n, 3, 3), np.nan))
+    rho = Interval(joint_boxes[:, :, 0], joint_boxes[:, :, 1])
+    todo = np.flatnonzero(np.isfinite(hulls).all(axis=(1, 2)))
+    for s in range(0, todo.size, _CHUNK):
+        idx = todo[s:s + _CHUNK]
+        for k in range(3):
+            idx = idx[~ok[idx]]
+            if idx.size == 0:
+                break
+            i, j = [a for a in range(3) if a != k]
+            P = Interval(np.stack([rho.lo[idx, i], rho.lo[idx, j]], 1), np.stack([rho.hi[idx, i], rho.hi[idx, j]], 1))
+            H = hulls[idx]
+            w = H[:, :, 1] - H[:, :, 0]
+            X = H + np.stack([-0.1 * w - 1e-9, 0.1 * w + 1e-9], axis=-1)
+            done = np.zeros(idx.size, dtype=bool)
+            K_ok = np.full(X.shape, np.nan)
+            Y_ok = np.full((idx.size, 3, 3), np.nan)
+            C_ok = Interval(np.full((idx.size, 3, 3), np.nan), np.full((idx.size, 3, 3), np.nan))
+            for _round in range(INFLATE_ROUNDS):
+                live = np.flatnonzero(~done)
+                if live.size == 0:
+                    break
+                Y, C = _preconditioned(geometry, X[live], k)
+                K = _krawczyk(geometry, X[live], k, P[live], Y, C)
+                good = _inside(K, X[live])
+                K_ok[live[good]], Y_ok[live[good]] = K[good], Y[good]
+                C_ok.lo[live[good]], C_ok.hi[live[good]] = C.lo[good], C.hi[good]
+                done[live[good]] = True
+                # epsilon inflation of the hull with the image (X only grows: it keeps every singular pose)
+                bad = live[~good]
+                Kb = K[~good]
+                fin = np.isfinite(Kb).all(axis=(1, 2))
+                grown = X[bad].copy()
+                grown[fin, :, 0] = np.minimum(grown[fin, :, 0], Kb[fin, :, 0])
+                grown[fin, :, 1] = np.maximum(grown[fin, :, 1], Kb[fin, :, 1])
+                gw = grown[:, :, 1] - grown[:, :, 0]
+                X[bad] = grown + np.stack([-0.25 * gw, 0.25 * gw], axis=-1)
+            sel = np.flatnonzero(done)
+            if sel.size == 0:
+                continue
+            Kd, Xd = K_ok[sel], X[sel]
+            hk = rho_sq_interval(geometry, Kd)[:, k].sqrt()
+            inside_k = (hk.lo > rho.lo[idx[sel], k]) & (hk.hi < rho.hi[idx[sel], k])
+            sg = _normal_signs(geometry, Kd)
+            monotone = (sg[:, i] != 0) & (sg[:, j] != 0) & (sg[:, k] != 0)
+            good = inside_k | monotone
+            g = idx[sel[good]]
+            ok[g], axis[g] = True, k
+            pose[g] = Xd[good]
+            height.lo[g], height.hi[g] = hk.lo[good], hk.hi[good]
+            inv[g] = Y_ok[sel[good]]
+            contraction.lo[g], contraction.hi[g] = C_ok.lo[sel[good]], C_ok.hi[sel[good]]
+    return FoldModels(ok, axis, pose, height, inv, contraction)
+
+
+def side_of(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(m,) int8: -1 where point q lies below the sheet of model ``box`` (q_k < h(q_i, q_j)), +1 above, 0 undecided.
+
+    box : (m,) indices of boxes with a model; points : (m, 3) float joint vectors inside
+    those boxes.  A few Krawczyk steps at the point parameter enclose X*(q_i, q_j) (the
+    unique zero in the model's pose box); q is placed when q_k^2 is outside the
+    enclosure of rho_k^2 there.  Certified.
+    """
+    box = np.asarray(box, dtype=np.int64)
+    q = np.asarray(points, dtype=np.float64)
+    out = np.zeros(len(box), dtype=np.int8)
+    for k in range(3):
+        sel = np.flatnonzero(models.axis[box] == k)
+        if sel.size == 0:
+            continue
+        i, j = [a for a in range(3) if a != k]
+        P = Interval.point(q[sel][:, [i, j]])
+        X = models.pose[box[sel]].copy()
+        alive = np.ones(sel.size, dtype=bool)
+        rows = box[sel]
+        for _ in range(SIDE_STEPS):
+            K = _krawczyk(geometry, X, k, P, models.inv[rows], models.contraction[rows])
+            fin = np.isfinite(K).all(axis=(1, 2))
+            alive &= fin
+            K = np.where(fin[:, None, None], K, X)
+            X = np.stack([np.maximum(X[:, :, 0], K[:, :, 0]), np.minimum(X[:, :, 1], K[:, :, 1])], axis=-1)
+        empty = (X[:, :, 0] > X[:, :, 1]).any(axis=1)
+        alive &= ~empty  # an empty intersection cannot happen for a proved model; claim nothing then
+        X = np.where(alive[:, None, None], X, models.pose[box[sel]])
+        h2 = rho_sq_interval(geometry, X)[:, k]
+        qk2 = Interval.point(q[sel, k]).sqr()
+        below = alive & (qk2.hi < h2.lo)
+        above = alive & (qk2.lo > h2.hi)
+        out[sel] = np.where(below, -1, np.where(above, 1, 0))
+    return out
