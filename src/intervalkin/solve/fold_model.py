@@ -29,7 +29,10 @@ empty) when either
   u_l = B_l - A_l (the left null vector of A), so dh/dr_i = -rho_i w_i / (rho_k w_k);
   signs of w_i, w_j, w_k certified on K give them.  Then B is monotone towards one corner
   of R_i x R_j, and every point of B joins the line over that corner (nested
-  monotonicity), which meets B in one segment; the same for T.
+  monotonicity), which meets B in one segment; the same for T; or
+* dh/dr_b has a certified sign for one parameter b, and h stays above lo_k on the edge
+  of R_i x R_j where h is largest along b (below hi_k on the opposite edge): every point
+  of B moves along b to that edge's face, then down to the edge, which lies in B.
 
 The two pieces have different counts (X*(p) is a fold point of g: E' regular means the
 kernel of A is transverse to S), and a point q of R off g(S) is placed in B or T by a
@@ -269,6 +272,22 @@ def fold_models(geometry: Geometry, joint_boxes: np.ndarray, hulls: np.ndarray) 
             sg = _normal_signs(geometry, Kd)
             monotone = (sg[:, i] != 0) & (sg[:, j] != 0) & (sg[:, k] != 0)
             good = inside_k | monotone
+            R = rho[idx[sel]]
+            for a, b in ((0, 1), (1, 0)):  # monotone along parameter b, both end edges checked along a
+                cand = np.flatnonzero(~good & (sg[:, k] != 0) & (sg[:, (i, j)[b]] != 0))
+                if cand.size == 0:
+                    continue
+                rb = (i, j)[b]
+                rising = -sg[cand, rb] * sg[cand, k] > 0  # dh/dr_b > 0
+                top = np.where(rising, R.hi[cand, rb], R.lo[cand, rb])  # where h is largest along b
+                low = np.where(rising, R.lo[cand, rb], R.hi[cand, rb])
+                edge = []
+                for at in (top, low):
+                    lo_p, hi_p = np.empty((cand.size, 2)), np.empty((cand.size, 2))
+                    lo_p[:, a], hi_p[:, a] = R.lo[cand, (i, j)[a]], R.hi[cand, (i, j)[a]]
+                    lo_p[:, b], hi_p[:, b] = at, at
+                    edge.append(_height(geometry, Xd[cand], k, Interval(lo_p, hi_p), Y_ok[sel[cand]], C_ok[sel[cand]]))
+                good[cand] = (edge[0].lo > R.lo[cand, k]) & (edge[1].hi < R.hi[cand, k])
             g = idx[sel[good]]
             ok[g], axis[g] = True, k
             pose[g] = Xd[good]
@@ -276,6 +295,24 @@ def fold_models(geometry: Geometry, joint_boxes: np.ndarray, hulls: np.ndarray) 
             inv[g] = Y_ok[sel[good]]
             contraction.lo[g], contraction.hi[g] = C_ok.lo[sel[good]], C_ok.hi[sel[good]]
     return FoldModels(ok, axis, pose, height, inv, contraction)
+
+
+def _height(geometry: Geometry, X: np.ndarray, k: int, P: Interval, Y: np.ndarray, C: Interval) -> Interval:
+    """An enclosure of h = rho_k(X*(p)) over the parameters P, by Krawczyk steps from the model's box X.
+
+    Every step keeps X*(p) (any box inside the model's X may take its Y and C), so the
+    intersection of the images holds it; NaN bounds where a step failed (no claim).
+    """
+    for _ in range(SIDE_STEPS):
+        K = _krawczyk(geometry, X, k, P, Y, C)
+        fin = np.isfinite(K).all(axis=(1, 2))
+        K = np.where(fin[:, None, None], K, np.stack([np.full(X.shape[:2], np.nan)] * 2, axis=-1))
+        X = np.stack([np.fmax(X[:, :, 0], K[:, :, 0]), np.fmin(X[:, :, 1], K[:, :, 1])], axis=-1)
+        X[~fin] = np.nan
+    h = rho_sq_interval(geometry, np.where(np.isfinite(X), X, 0.0))[:, k].sqrt()
+    bad = ~np.isfinite(X).all(axis=(1, 2)) | (X[:, :, 0] > X[:, :, 1]).any(axis=1)
+    h.lo[bad], h.hi[bad] = np.nan, np.nan
+    return h
 
 
 def side_of(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray) -> np.ndarray:

@@ -222,7 +222,7 @@ def _to_paving(domain: np.ndarray, leaves: tuple[np.ndarray, ...], stats: list[d
 
 
 def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_levels: int = JOIN_LEVELS,
-                     progress: Callable[[dict], None] | None = None, fold: bool = True) -> JointSpacePaving:
+                     progress: Callable[[dict], None] | None = None, fold: bool = False) -> JointSpacePaving:
     """Pave the joint box to ``depth`` with the clear-box test, join cells across walls, and count them.
 
     Parameters
@@ -232,7 +232,9 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     join_levels : further levels, only in undecided boxes that separate two cells of
         equal count and split (0: no joins).
     fold : give the undecided leaves fold models (:mod:`intervalkin.solve.fold_model`) where
-        they can be proved; their pieces join the cells and count as certified volume.
+        they can be proved; their pieces join the cells and count as certified volume.  Off by
+        default: at depth 7 it certifies 2.6 % more of the joint box (87.5 % -> 90.1 %) for
+        about twice the CPU time, and changes no cell of the paper's manipulator.
 
     Cost: the undecided boxes lie along the 2-D surface g(S), so their number grows
     like 4**depth; each cell costs one certified solve.
