@@ -147,3 +147,30 @@ def test_piece_edges_join_sets_of_one_count(folds):
     assert np.all(node_cell[a] == node_cell[b])
     assert np.count_nonzero(node_cell[a] >= 0) > a.size // 4
     assert np.all(a < n + 2 * len(folds.pieces)) and np.all(b >= n)  # sorted pairs: the larger end is a piece
+
+
+def test_lines_along_the_axis_cross_the_sheet_at_most_once(folds, paper_geometry):
+    """The graph claim: along a line of a fold box parallel to its axis k, the certified count
+    changes at most once, from the count below the sheet to the count above it."""
+    rng = np.random.default_rng(12)
+    models = folds.pieces.models
+    rows = rng.choice(len(models), size=12, replace=False)
+    crossings = 0
+    for t in rows:
+        lo, hi = folds.paving.lo[folds.pieces.box[t]], folds.paving.hi[folds.pieces.box[t]]
+        k = int(models.axis[t])
+        for _ in range(2):
+            base = lo + rng.random(3) * (hi - lo)
+            zs = np.linspace(lo[k], hi[k], 17)
+            q = np.repeat(base[None], len(zs), axis=0)
+            q[:, k] = zs
+            side = side_of(paper_geometry, models, np.full(len(zs), t), q)
+            splits = [split_of(solve(paper_geometry, [Fraction(float(v)) for v in p])) for p in q]
+            changes = sum(1 for a, b in zip(splits, splits[1:]) if a != b)
+            assert changes <= 1, (t, k, splits)
+            crossings += changes
+            placed = [(s, sp) for s, sp in zip(side, splits) if s != 0]
+            assert all(s1 <= s2 for (s1, _), (s2, _) in zip(placed, placed[1:])), side  # below, then above
+            for s in (-1, 1):
+                assert len({sp for si, sp in placed if si == s}) <= 1, (t, side, splits)
+    assert crossings >= 3

@@ -106,3 +106,18 @@ def test_large_cells_are_the_same_one_level_finer(paper_geometry):
         if c.volume >= 0.01 * total:
             cid = finer.cell_of(np.array([[float(v) for v in c.witness]]))[0]
             assert cid >= 0 and finer.cells[[x.id for x in finer.cells].index(cid)].signature == c.signature
+
+
+def test_face_levels_refine_only_boxes_on_the_faces(paper_geometry, joint4):
+    """face_levels: undecided boxes touching a face of the joint box go deeper; nothing else changes."""
+    jp = pave_joint_space(paper_geometry, 4, join_levels=0, face_levels=2)
+    dom = joint_domain(paper_geometry)
+    p = jp.paving
+    deep = p.level > 4
+    assert deep.any() and p.level.max() == 6
+    # a deep box lies in a depth-4 box on a face: within 1/16 of the range from it
+    step = (dom[:, 1] - dom[:, 0]) / 16
+    touch = ((p.lo <= dom[:, 0] + step) | (p.hi >= dom[:, 1] - step)).any(axis=1)
+    assert np.all(touch[deep])
+    assert p.volume().sum() == pytest.approx(joint4.paving.volume().sum(), rel=1e-12)
+    assert jp.certified_share() > joint4.certified_share() - 1e-9

@@ -133,28 +133,30 @@ def pose_hulls(geometry: Geometry, joint_boxes: np.ndarray, owner: np.ndarray, c
     return out
 
 
-def _rows(geometry: Geometry, X: np.ndarray, k: int) -> Interval:
-    """E'(X): the rows grad rho_i^2, grad rho_j^2, grad det A over the pose boxes, (n, 3, 3)."""
-    i, j = [a for a in range(3) if a != k]
-    A = jacobian_interval(geometry, X)
-    G = det_a_gradient_interval(geometry, X)
-    return Interval(np.stack([A.lo[:, i], A.lo[:, j], G.lo], 1), np.stack([A.hi[:, i], A.hi[:, j], G.hi], 1))
+def _gradients(geometry: Geometry, X: np.ndarray) -> tuple[Interval, Interval]:
+    """(A, grad det A) over pose boxes X: every row E' may take, for any axis."""
+    return jacobian_interval(geometry, X), det_a_gradient_interval(geometry, X)
 
 
-def _residual(geometry: Geometry, m: np.ndarray, k: int, P: Interval) -> Interval:
-    """E(m; P) at float poses m (n, 3) for parameter boxes P (n, 2) of (r_i, r_j)."""
+def _values(geometry: Geometry, m: np.ndarray) -> tuple[Interval, Interval]:
+    """(rho_l^2, det A) at float poses m (n, 3), enclosed."""
     pts = np.stack([m, m], axis=-1)
-    e = rho_sq_interval(geometry, pts)
+    return rho_sq_interval(geometry, pts), det_a_interval(geometry, pts)
+
+
+def _residual(values: tuple[Interval, Interval], k: int, P: Interval) -> Interval:
+    """E(m; P) from the values at m, for parameter boxes P (n, 2) of (r_i, r_j)."""
+    e, d = values
     i, j = [a for a in range(3) if a != k]
-    d = det_a_interval(geometry, pts)
-    Pi, Pj = P[:, 0].sqr(), P[:, 1].sqr()
-    ri, rj = e[:, i] - Pi, e[:, j] - Pj
+    ri, rj = e[:, i] - P[:, 0].sqr(), e[:, j] - P[:, 1].sqr()
     return Interval(np.stack([ri.lo, rj.lo, d.lo], 1), np.stack([ri.hi, rj.hi, d.hi], 1))
 
 
-def _preconditioned(geometry: Geometry, X: np.ndarray, k: int) -> tuple[np.ndarray, Interval]:
-    """(Y, C): Y = mid(E'(X))^-1 (NaN where singular) and C = I - Y E'(X) (interval), over pose boxes X."""
-    J = _rows(geometry, X, k)
+def _preconditioned(grads: tuple[Interval, Interval], k: int) -> tuple[np.ndarray, Interval]:
+    """(Y, C): Y = mid(E'(X))^-1 (NaN where singular) and C = I - Y E'(X) (interval), from the gradients over X."""
+    A, G = grads
+    i, j = [a for a in range(3) if a != k]
+    J = Interval(np.stack([A.lo[:, i], A.lo[:, j], G.lo], 1), np.stack([A.hi[:, i], A.hi[:, j], G.hi], 1))
     with np.errstate(all="ignore"):
         M = 0.5 * (J.lo + J.hi)
         ok = np.isfinite(M).all(axis=(1, 2)) & (np.abs(np.linalg.det(np.where(np.isfinite(M), M, 0.0))) > 1e-300)
@@ -164,22 +166,24 @@ def _preconditioned(geometry: Geometry, X: np.ndarray, k: int) -> tuple[np.ndarr
     C_lo, C_hi = np.empty(M.shape), np.empty(M.shape)
     for a in range(3):
         for b in range(3):
-            c = Interval.point(np.full(len(X), 1.0 if a == b else 0.0))
+            c = Interval.point(np.full(len(M), 1.0 if a == b else 0.0))
             for d in range(3):
                 c = c - J[:, d, b] * Y[:, a, d]
             C_lo[:, a, b], C_hi[:, a, b] = c.lo, c.hi
     return Y, Interval(C_lo, C_hi)
 
 
-def _krawczyk(geometry: Geometry, X: np.ndarray, k: int, P: Interval, Y: np.ndarray, C: Interval) -> np.ndarray:
+def _krawczyk(geometry: Geometry, X: np.ndarray, k: int, P: Interval, Y: np.ndarray, C: Interval,
+              values: tuple[Interval, Interval] | None = None) -> np.ndarray:
     """The Krawczyk image (n, 3, 2) of pose boxes X for parameters P, with Y and C = I - Y E'(X') for X' containing X.
 
     Any C computed over a box containing X is sound (the mean value theorem only needs
     an enclosure of E' over X), so a side test reuses the C of its model's proof.
+    ``values`` are the enclosures at mid(X) when already known.
     """
     Xi = Interval(X[:, :, 0], X[:, :, 1])
     m = Xi.mid()
-    F = _residual(geometry, m, k, P)
+    F = _residual(_values(geometry, m) if values is None else values, k, P)
     D = Xi - m
     K_lo, K_hi = np.empty(m.shape), np.empty(m.shape)
     for a in range(3):
@@ -231,15 +235,22 @@ def fold_models(geometry: Geometry, joint_boxes: np.ndarray, hulls: np.ndarray) 
     todo = np.flatnonzero(np.isfinite(hulls).all(axis=(1, 2)))
     for s in range(0, todo.size, _CHUNK):
         idx = todo[s:s + _CHUNK]
+        # the first box X is the same for every axis: its gradients and mid values are computed once
+        H0 = hulls[idx]
+        w0 = H0[:, :, 1] - H0[:, :, 0]
+        X0 = H0 + np.stack([-0.1 * w0 - 1e-9, 0.1 * w0 + 1e-9], axis=-1)
+        grads0 = _gradients(geometry, X0)
+        values0 = _values(geometry, Interval(X0[:, :, 0], X0[:, :, 1]).mid())
+        chunk_pos = np.full(n, -1)
+        chunk_pos[idx] = np.arange(idx.size)
         for k in range(3):
             idx = idx[~ok[idx]]
             if idx.size == 0:
                 break
             i, j = [a for a in range(3) if a != k]
             P = Interval(np.stack([rho.lo[idx, i], rho.lo[idx, j]], 1), np.stack([rho.hi[idx, i], rho.hi[idx, j]], 1))
-            H = hulls[idx]
-            w = H[:, :, 1] - H[:, :, 0]
-            X = H + np.stack([-0.1 * w - 1e-9, 0.1 * w + 1e-9], axis=-1)
+            at = chunk_pos[idx]
+            X = X0[at]
             done = np.zeros(idx.size, dtype=bool)
             K_ok = np.full(X.shape, np.nan)
             Y_ok = np.full((idx.size, 3, 3), np.nan)
@@ -248,8 +259,14 @@ def fold_models(geometry: Geometry, joint_boxes: np.ndarray, hulls: np.ndarray) 
                 live = np.flatnonzero(~done)
                 if live.size == 0:
                     break
-                Y, C = _preconditioned(geometry, X[live], k)
-                K = _krawczyk(geometry, X[live], k, P[live], Y, C)
+                if _round == 0:
+                    first = at[live]
+                    grads = (grads0[0][first], grads0[1][first])
+                    vals = (values0[0][first], values0[1][first])
+                else:
+                    grads, vals = _gradients(geometry, X[live]), None
+                Y, C = _preconditioned(grads, k)
+                K = _krawczyk(geometry, X[live], k, P[live], Y, C, vals)
                 good = _inside(K, X[live])
                 K_ok[live[good]], Y_ok[live[good]] = K[good], Y[good]
                 C_ok.lo[live[good]], C_ok.hi[live[good]] = C.lo[good], C.hi[good]

@@ -51,6 +51,8 @@ __all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_doma
 DEFAULT_JOINT_DEPTH = 7
 #: Further levels, only in the walls between cells of equal count.
 JOIN_LEVELS = 2
+#: Further levels in the undecided boxes that touch a face of the joint box (where thin cells hug the limits).
+FACE_LEVELS = 0
 
 
 @dataclass(frozen=True, eq=False)
@@ -222,7 +224,8 @@ def _to_paving(domain: np.ndarray, leaves: tuple[np.ndarray, ...], stats: list[d
 
 
 def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_levels: int = JOIN_LEVELS,
-                     progress: Callable[[dict], None] | None = None, fold: bool = False) -> JointSpacePaving:
+                     progress: Callable[[dict], None] | None = None, fold: bool = False,
+                     face_levels: int = FACE_LEVELS) -> JointSpacePaving:
     """Pave the joint box to ``depth`` with the clear-box test, join cells across walls, and count them.
 
     Parameters
@@ -240,16 +243,29 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     like 4**depth; each cell costs one certified solve.
     """
     check_depth(depth)
-    if isinstance(join_levels, bool) or not isinstance(join_levels, int) or not 0 <= join_levels <= 8:
-        raise InputError(f"join_levels: expected an integer in 0..8, got {join_levels!r}")
+    for name, v in (("join_levels", join_levels), ("face_levels", face_levels)):
+        if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 8:
+            raise InputError(f"{name}: expected an integer in 0..8, got {v!r}")
     domain = joint_domain(geometry)
     found_leaves, stats = _adaptive(geometry, domain, depth, progress)
     leaves = found_leaves.merge()
+    for extra in range(face_levels):
+        # thin cells hug the faces rho_i = rho_min / rho_max: refine the undecided leaves that touch one
+        level, lo, hi, clear = leaves[0], leaves[2], leaves[3], leaves[4]
+        touch = ((lo <= domain[:, 0]) | (hi >= domain[:, 1])).any(axis=1)
+        wall = ~clear & touch & (level >= depth + extra)
+        if progress is not None:
+            progress({"stage": "faces", "level": depth + extra + 1, "depth": depth + face_levels,
+                      "boxes": int(np.count_nonzero(wall)), "split": int(np.count_nonzero(wall))})
+        if not np.any(wall):
+            break
+        leaves = _refine(geometry, domain, leaves, wall)
+    fine = depth + max(face_levels, join_levels)
     cells = CellSolver(geometry)
     store = _FoldStore(geometry) if fold else None
     for extra in range(join_levels + 1):
         paving = _to_paving(domain, leaves, stats)
-        cell, found, _, _ = cells.label(paving, depth + join_levels)
+        cell, found, _, _ = cells.label(paving, fine)
         if extra == join_levels:
             break
         wall = joining_paths(cells.edges, cell, found) & (paving.level < depth + join_levels)
@@ -263,7 +279,7 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     if fold:
         t0 = time.perf_counter()
         store = _FoldStore(geometry)
-        cell, found, pieces, piece_cell = cells.label(paving, depth + join_levels, lambda e: store.pieces(leaves, e))
+        cell, found, pieces, piece_cell = cells.label(paving, fine, lambda e: store.pieces(leaves, e))
         unjoined = cells.unjoined
         fold_stats = {"fold_boxes": 0 if pieces is None else len(pieces), "seconds": time.perf_counter() - t0,
                       "unjoined_piece_groups": unjoined[0], "unjoined_piece_volume": unjoined[1]}
