@@ -1,6 +1,6 @@
 """Benchmark of the direct joint-space paving (a script, not a test).
 
-    python benchmarks/bench_joint_paving.py [--depths 5 6 7] [--geometry FILE] [--samples 2000] [--fold]
+    python benchmarks/bench_joint_paving.py [--depths 5 6 7] [--geometry FILE] [--samples 2000] [--fold] [--face-levels 3]
 
 Per depth: boxes, wall time, peak memory (resident set of this process), the share of
 the joint box's volume in boxes certified off g(S), the cells (count: number), the
@@ -58,13 +58,14 @@ def main() -> None:
     ap.add_argument("--geometry", default=None)
     ap.add_argument("--samples", type=int, default=1000, help="random joint vectors checked by certified solves")
     ap.add_argument("--fold", action="store_true", help="give undecided boxes fold models (solve.fold_model)")
+    ap.add_argument("--face-levels", type=int, default=0, help="further levels for undecided boxes on the faces")
     args = ap.parse_args()
     g = default_geometry() if args.geometry is None else load_geometry(args.geometry)
     print(f"{'depth':>5} {'boxes':>9} {'seconds':>8} {'peak MB':>8} {'certified':>9} {'regions':>7} "
           f"{'labelled':>8} {'agree':>6} {'wrong':>5}   cells (count: number)")
     for depth in args.depths:
         t0 = time.perf_counter()
-        jp = pave_joint_space(g, depth, fold=args.fold)
+        jp = pave_joint_space(g, depth, fold=args.fold, face_levels=args.face_levels)
         dt = time.perf_counter() - t0
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
         n, labelled, agree, wrong = _agreement(g, jp, args.samples, seed=depth)
