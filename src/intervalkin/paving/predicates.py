@@ -27,10 +27,11 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.kinematics.constants import constants
 from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_interval
+from intervalkin.paving.contracted import ASPECT_NAMES, contract_label
 from intervalkin.paving.labels import Label, and_labels, not_label
 from intervalkin.paving.tree import Paving, pave_multi, workspace_paving_domain
 
-__all__ = ['workspace_labels', 'det_sign_labels', 'aspect_labels', 'workspace_predicate', 'det_sign_predicate', 'and_predicates', 'not_predicate', 'aspect_predicate', 'pave_workspace']
+__all__ = ['workspace_labels', 'det_sign_labels', 'aspect_labels', 'workspace_predicate', 'det_sign_predicate', 'and_predicates', 'not_predicate', 'aspect_predicate', 'contract_paving', 'pave_workspace']
 
 
 # --------------------------------------------------------------------------------------
@@ -92,7 +93,22 @@ def aspect_predicate(geometry: Geometry, sign: int):
     return and_predicates(workspace_predicate(geometry), d if sign > 0 else not_predicate(d))
 
 
-def pave_workspace(geometry: Geometry, depth: int, progress=None, split=None) -> Paving:
+def contract_paving(geometry: Geometry, paving: Paving, refine: int = 0) -> dict:
+    """Cut the BOUNDARY leaves of W, WA1 and WA2 into parts proved INSIDE / OUTSIDE.
+
+    Returns name -> :class:`~intervalkin.paving.contracted.ContractedParts` (stored beside
+    the grid, which is left unchanged); ``refine``: bisect-and-cut rounds of the remainders.
+    """
+    scale = (paving.domain[:, 1] - paving.domain[:, 0]) * 2.0 ** -paving.depth
+    out = {}
+    for name in ASPECT_NAMES:
+        rows = np.flatnonzero(paving.labels[name] == Label.BOUNDARY)
+        out[name] = contract_label(geometry, name, paving.lo[rows], paving.hi[rows], rows, refine, scale)
+    return out
+
+
+def pave_workspace(geometry: Geometry, depth: int, progress=None, split=None,
+                   contract: bool = False, refine: int = 0) -> Paving:
     """Pave W, the sign of det A and the two aspects in one pass.
 
     Labels: ``W``, ``det_positive`` (INSIDE: det A > 0, OUTSIDE: det A < 0),
@@ -100,6 +116,8 @@ def pave_workspace(geometry: Geometry, depth: int, progress=None, split=None) ->
     and the sign of det A is undecided (that is: while an aspect label is
     undecided).  det A is not evaluated on boxes certified outside W.  ``split``
     replaces that rule (labels -> bool mask of the boxes to subdivide).
+    ``contract``: also cut the BOUNDARY leaves of W, WA1 and WA2 into proved parts
+    (:func:`contract_paving`, ``refine`` rounds), stored in ``Paving.parts``.
     """
     def aspect_split(labels):
         w, d = labels["W"], labels["det_positive"]
@@ -116,4 +134,6 @@ def pave_workspace(geometry: Geometry, depth: int, progress=None, split=None) ->
         progress=progress,
     )
     p.labels["WA1"], p.labels["WA2"] = aspect_labels(p.labels["W"], p.labels["det_positive"])
+    if contract:
+        p.parts.update(contract_paving(geometry, p, refine))
     return p

@@ -79,6 +79,9 @@ class Paving:
     lo, hi : ndarray (n, 3) float64, the box bounds.
     labels : dict name -> ndarray (n,) uint8 of :class:`Label`.
     stats : list of per-level dicts (boxes evaluated, seconds, undecided volume).
+    parts : dict name -> off-grid parts of the BOUNDARY leaves of that label, proved
+        INSIDE / OUTSIDE by contractors (:class:`intervalkin.paving.contracted.ContractedParts`);
+        empty unless asked for.  The grid above does not depend on them.
     """
 
     domain: np.ndarray
@@ -89,6 +92,7 @@ class Paving:
     hi: np.ndarray
     labels: dict[str, np.ndarray] = field(default_factory=dict)
     stats: list[dict] = field(default_factory=list)
+    parts: dict = field(default_factory=dict)
 
     def __len__(self) -> int:
         return int(self.level.shape[0])
@@ -102,15 +106,26 @@ class Paving:
         """Volume of each box (n,), float (a measure, not a certified quantity)."""
         return np.prod(self.hi - self.lo, axis=1)
 
-    def volume_by_label(self, name: str) -> dict[str, float]:
-        """Total volume of INSIDE, BOUNDARY (undecided) and OUTSIDE boxes of one label."""
+    def volume_by_label(self, name: str, contracted: bool = False) -> dict[str, float]:
+        """Total volume of INSIDE, BOUNDARY (undecided) and OUTSIDE boxes of one label.
+
+        ``contracted``: the BOUNDARY leaves that were cut into parts (``parts[name]``)
+        count by their parts instead (KeyError when the label has no parts).
+        """
         v = self.volume()
         lab = self.labels[name]
-        return {
+        out = {
             "inside": float(v[lab == Label.INSIDE].sum()),
             "boundary": float(v[lab == Label.BOUNDARY].sum()),
             "outside": float(v[lab == Label.OUTSIDE].sum()),
         }
+        if contracted:
+            parts = self.parts[name]
+            cut = np.unique(parts.leaf)
+            out["boundary"] -= float(v[cut].sum())
+            for k, pv in parts.volume_by_label().items():
+                out[k] += pv
+        return out
 
     def count_by_label(self, name: str) -> dict[str, int]:
         lab = self.labels[name]
@@ -119,8 +134,12 @@ class Paving:
 
     def subset(self, mask: np.ndarray) -> "Paving":
         """The boxes selected by a boolean mask or index array (labels kept)."""
+        new_index = np.full(len(self), -1, dtype=np.int64)
+        kept = np.arange(len(self))[mask]
+        new_index[kept] = np.arange(kept.size)
         return Paving(self.domain, self.depth, self.level[mask], self.ijk[mask], self.lo[mask], self.hi[mask],
-                      {k: v[mask] for k, v in self.labels.items()}, list(self.stats))
+                      {k: v[mask] for k, v in self.labels.items()}, list(self.stats),
+                      {k: v.reindex(new_index) for k, v in self.parts.items()})
 
     @functools.cached_property
     def _sorted_keys(self) -> tuple[np.ndarray, np.ndarray]:
