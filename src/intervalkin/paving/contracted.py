@@ -253,8 +253,9 @@ def contract_label(geometry: Geometry, name: str, lo: np.ndarray, hi: np.ndarray
             rem[0].append(m_lo)
             rem[1].append(m_hi)
             rem[2].append(leaf[s:s + CHUNK][rows])
-        lo, hi, leaf = (np.concatenate(v) if v else np.zeros((0, 3)) for v in rem)
-        leaf = leaf.astype(np.int64)
+        lo = np.concatenate(rem[0]) if rem[0] else np.zeros((0, 3))
+        hi = np.concatenate(rem[1]) if rem[1] else np.zeros((0, 3))
+        leaf = np.concatenate(rem[2]).astype(np.int64) if rem[2] else np.zeros(0, dtype=np.int64)
         if step < refine and len(lo):
             lo, hi = _bisect(lo, hi, scale)
             leaf = np.concatenate([leaf, leaf])
