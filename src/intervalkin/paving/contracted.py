@@ -40,7 +40,7 @@ from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_interval
 from intervalkin.paving.contract import contract_det, contract_leg
 from intervalkin.paving.labels import Label
 
-__all__ = ['ContractedParts', 'box_minus', 'contract_label', 'ASPECT_NAMES']
+__all__ = ['ContractedParts', 'box_minus', 'contract_label', 'contract_labels', 'ASPECT_NAMES']
 
 #: The labels this module cuts: W and the two aspects.
 ASPECT_NAMES = ("W", "WA1", "WA2")
@@ -121,48 +121,63 @@ def _hull(acc, lo, hi, empty, rows):
     a_hi[ok] = np.maximum(a_hi[ok], hi[~empty])
 
 
-def _workspace_cut(geometry: Geometry, lo, hi):
+def _workspace_cut(geometry: Geometry, lo, hi, undecided=None):
     """(hold box, fail box) of W: hold contains every point of W in B, fail every point off W.
 
     Boxes are (lo, hi) pairs of (n, 3) arrays; an empty box has lo = +inf, hi = -inf.
-    Legs proved inside their limits on B (phi-tight enclosure) are skipped.
+    ``undecided`` (n,) bool: the rows to work on; the others must be proved inside W
+    (hold = B, fail empty).  Legs proved inside their limits on B (phi-tight enclosure)
+    are skipped.
     """
     k = constants(geometry)
     n = len(lo)
-    r = rho_sq_interval(geometry, np.stack([lo, hi], axis=-1))
     fail = (np.full((n, 3), np.inf), np.full((n, 3), -np.inf))
+    hold = (lo.copy(), hi.copy())
+    rows = np.arange(n) if undecided is None else np.flatnonzero(undecided)
+    if rows.size == 0:
+        return hold, fail
+    lo, hi = lo[rows], hi[rows]
+    r = rho_sq_interval(geometry, np.stack([lo, hi], axis=-1))
     h_lo, h_hi = lo.copy(), hi.copy()
-    h_empty = np.zeros(n, dtype=bool)
+    h_empty = np.zeros(len(rows), dtype=bool)
+    mn, mx = k.rho_min_sq_iv, k.rho_max_sq_iv
     for i in range(3):
-        mn, mx = k.rho_min_sq_iv, k.rho_max_sq_iv
         low = r.lo[:, i] < mn.hi[i]    # rho_i may be below its minimum somewhere in B
         high = r.hi[:, i] > mx.lo[i]   # ... or above its maximum
         h_empty |= (r.hi[:, i] < mn.lo[i]) | (r.lo[:, i] > mx.hi[i])
         for mask, target in ((low, (-np.inf, mn.hi[i])), (high, (mx.lo[i], np.inf))):
-            rows = np.flatnonzero(mask)
-            if rows.size:
-                c_lo, c_hi, e = contract_leg(geometry, lo[rows], hi[rows], i, target)
-                _hull(fail, c_lo, c_hi, e, rows)
-        rows = np.flatnonzero((low | high) & ~h_empty)
-        if rows.size:
-            c_lo, c_hi, e = contract_leg(geometry, h_lo[rows], h_hi[rows], i, (mn.lo[i], mx.hi[i]))
-            h_lo[rows], h_hi[rows] = c_lo, c_hi
-            h_empty[rows] |= e
+            sel = np.flatnonzero(mask)
+            if sel.size:
+                c_lo, c_hi, e = contract_leg(geometry, lo[sel], hi[sel], i, target)
+                _hull(fail, c_lo, c_hi, e, rows[sel])
+        sel = np.flatnonzero((low | high) & ~h_empty)
+        if sel.size:
+            c_lo, c_hi, e = contract_leg(geometry, h_lo[sel], h_hi[sel], i, (mn.lo[i], mx.hi[i]))
+            h_lo[sel], h_hi[sel] = c_lo, c_hi
+            h_empty[sel] |= e
     h_lo[h_empty], h_hi[h_empty] = np.inf, -np.inf
-    return (h_lo, h_hi), fail
+    hold[0][rows], hold[1][rows] = h_lo, h_hi
+    return hold, fail
 
 
-def _det_cut(geometry: Geometry, lo, hi):
-    """(box holding every point of B with det A >= 0, box holding every point with det A <= 0)."""
-    d = det_a_interval(geometry, np.stack([lo, hi], axis=-1))
+def _det_cut(geometry: Geometry, lo, hi, sign=None):
+    """(box holding every point of B with det A >= 0, box holding every point with det A <= 0).
+
+    ``sign`` (n,) int8: a certified sign of det A on each box (1, -1; 0 undecided), from the
+    grid labels; None: enclosed here.
+    """
+    if sign is None:
+        d = det_a_interval(geometry, np.stack([lo, hi], axis=-1))
+        sign = np.where(d.lo > 0, 1, np.where(d.hi < 0, -1, 0))
     out = []
-    for sign, none in ((1, d.hi < 0), (-1, d.lo > 0)):
+    for s in (1, -1):
         b_lo, b_hi = lo.copy(), hi.copy()
-        rows = np.flatnonzero(~none & ~((d.lo > 0) if sign > 0 else (d.hi < 0)))  # sign undecided on B
+        rows = np.flatnonzero(sign == 0)
         if rows.size:
-            c_lo, c_hi, e = contract_det(geometry, lo[rows], hi[rows], sign)
+            c_lo, c_hi, e = contract_det(geometry, lo[rows], hi[rows], s)
             c_lo[e], c_hi[e] = np.inf, -np.inf
             b_lo[rows], b_hi[rows] = c_lo, c_hi
+        none = sign == -s  # det A has the other sign on the whole box
         b_lo[none], b_hi[none] = np.inf, -np.inf
         out.append((b_lo, b_hi))
     return out
@@ -179,15 +194,16 @@ def _hull_boxes(a, b):
     return np.minimum(a[0], b[0]), np.maximum(a[1], b[1])
 
 
-def _cut(geometry: Geometry, name: str, lo, hi):
-    """(hold, fail) boxes of label ``name`` on the boxes (lo, hi)."""
-    hold, fail = _workspace_cut(geometry, lo, hi)
-    if name == "W":
-        return hold, fail
-    pos, neg = _det_cut(geometry, lo, hi)
-    if name == "WA1":  # W and det A > 0: fails where W fails or det A <= 0
-        return _meet_boxes(hold, pos), _hull_boxes(fail, neg)
-    return _meet_boxes(hold, neg), _hull_boxes(fail, pos)
+def _cuts(geometry: Geometry, names, lo, hi, w_undecided=None, det_sign=None) -> dict:
+    """name -> (hold, fail) boxes on the boxes (lo, hi); W and det A are contracted once for all names."""
+    hold, fail = _workspace_cut(geometry, lo, hi, w_undecided)
+    out = {"W": (hold, fail)}
+    if "WA1" in names or "WA2" in names:
+        pos, neg = _det_cut(geometry, lo, hi, det_sign)
+        # WA1 = W and det A > 0 fails where W fails or det A <= 0; WA2 the same with the signs swapped
+        out["WA1"] = (_meet_boxes(hold, pos), _hull_boxes(fail, neg))
+        out["WA2"] = (_meet_boxes(hold, neg), _hull_boxes(fail, pos))
+    return {n: out[n] for n in names}
 
 
 def _parts(lo, hi, hold, fail):
@@ -233,36 +249,75 @@ def contract_label(geometry: Geometry, name: str, lo: np.ndarray, hi: np.ndarray
     ----------
     lo, hi : ndarray (n, 3), the boxes; leaf : (n,) their grid indices (stored in the parts).
     refine : times the remainders are bisected (across their widest side, widths in
-        ``scale`` units, default the box widths of the first box) and cut again.
+        ``scale`` units, default the widths of the first box) and cut again.
 
     Returns the parts, which tile the boxes.  Certified (module docstring).
     """
     if name not in ASPECT_NAMES:
         raise ValueError(f"name: expected one of {ASPECT_NAMES}, got {name!r}")
+    n = len(lo)
+    return contract_labels(geometry, lo, hi, leaf, {name: np.ones(n, dtype=bool)}, refine=refine, scale=scale)[name]
+
+
+def contract_labels(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, leaf: np.ndarray, rows_of: dict,
+                    w_undecided=None, det_sign=None, refine: int = 0, scale=None) -> dict[str, ContractedParts]:
+    """Cut boxes into proved parts for several labels at once (W and det A contracted once per box).
+
+    ``rows_of`` : name -> (n,) bool, the boxes to cut for that label (its undecided leaves).
+    ``w_undecided``, ``det_sign`` : optional certified knowledge from the grid: the rows where
+    W is not proved (the others must be proved inside W), and the sign of det A (1, -1, 0).
+    The remainders are then bisected and cut ``refine`` times, label by label.
+    """
     lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
     leaf = np.asarray(leaf, dtype=np.int64)
     scale = (hi[0] - lo[0]) if (scale is None and len(lo)) else scale
-    acc: list[tuple] = []
-    for step in range(refine + 1):
-        rem = ([], [], [])
-        for s in range(0, len(lo), CHUNK):
-            b_lo, b_hi = lo[s:s + CHUNK], hi[s:s + CHUNK]
-            hold, fail = _cut(geometry, name, b_lo, b_hi)
-            parts, (m_lo, m_hi, rows) = _parts(b_lo, b_hi, hold, fail)
-            acc += [(p_lo, p_hi, leaf[s:s + CHUNK][r], lab) for p_lo, p_hi, r, lab in parts]
-            rem[0].append(m_lo)
-            rem[1].append(m_hi)
-            rem[2].append(leaf[s:s + CHUNK][rows])
-        lo = np.concatenate(rem[0]) if rem[0] else np.zeros((0, 3))
-        hi = np.concatenate(rem[1]) if rem[1] else np.zeros((0, 3))
-        leaf = np.concatenate(rem[2]).astype(np.int64) if rem[2] else np.zeros(0, dtype=np.int64)
-        if step < refine and len(lo):
-            lo, hi = _bisect(lo, hi, scale)
-            leaf = np.concatenate([leaf, leaf])
-    acc.append((lo, hi, leaf, Label.BOUNDARY))
-    return ContractedParts(
-        leaf=np.concatenate([a[2] for a in acc]).astype(np.int64),
-        lo=np.concatenate([a[0] for a in acc]).reshape(-1, 3),
-        hi=np.concatenate([a[1] for a in acc]).reshape(-1, 3),
-        label=np.concatenate([np.full(len(a[2]), a[3], dtype=np.uint8) for a in acc]),
-    )
+    names = list(rows_of)
+    acc: dict[str, list] = {nm: [] for nm in names}
+    rem: dict[str, list] = {nm: [] for nm in names}
+    for s in range(0, len(lo), CHUNK):
+        sl = slice(s, s + CHUNK)
+        any_row = np.zeros(len(lo[sl]), dtype=bool)
+        for nm in names:
+            any_row |= rows_of[nm][sl]
+        sel = np.flatnonzero(any_row)
+        cuts = _cuts(geometry, names, lo[sl][sel], hi[sl][sel],
+                     None if w_undecided is None else w_undecided[sl][sel], None if det_sign is None else det_sign[sl][sel])
+        for nm in names:
+            mine = rows_of[nm][sl][sel]
+            hold, fail = (tuple(a[mine] for a in box) for box in cuts[nm])
+            _collect(acc[nm], rem[nm], lo[sl][sel][mine], hi[sl][sel][mine], leaf[sl][sel][mine], hold, fail)
+    out = {}
+    for nm in names:
+        r_lo, r_hi, r_leaf = _joined(rem[nm])
+        for _ in range(refine):
+            r_lo, r_hi = _bisect(r_lo, r_hi, scale)
+            r_leaf = np.concatenate([r_leaf, r_leaf])
+            nxt: list = []
+            for s in range(0, len(r_lo), CHUNK):
+                b_lo, b_hi = r_lo[s:s + CHUNK], r_hi[s:s + CHUNK]
+                hold, fail = _cuts(geometry, [nm], b_lo, b_hi)[nm]
+                _collect(acc[nm], nxt, b_lo, b_hi, r_leaf[s:s + CHUNK], hold, fail)
+            r_lo, r_hi, r_leaf = _joined(nxt)
+        acc[nm].append((r_lo, r_hi, r_leaf, Label.BOUNDARY))
+        a = acc[nm]
+        out[nm] = ContractedParts(
+            leaf=np.concatenate([x[2] for x in a]).astype(np.int64),
+            lo=np.concatenate([x[0] for x in a]).reshape(-1, 3),
+            hi=np.concatenate([x[1] for x in a]).reshape(-1, 3),
+            label=np.concatenate([np.full(len(x[2]), x[3], dtype=np.uint8) for x in a]),
+        )
+    return out
+
+
+def _collect(acc: list, rem: list, lo, hi, leaf, hold, fail) -> None:
+    """Append the decided parts of boxes to ``acc`` and their remainders to ``rem``."""
+    parts, (m_lo, m_hi, rows) = _parts(lo, hi, hold, fail)
+    acc += [(p_lo, p_hi, leaf[r], lab) for p_lo, p_hi, r, lab in parts]
+    rem.append((m_lo, m_hi, leaf[rows]))
+
+
+def _joined(rem: list):
+    if not rem:
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, dtype=np.int64)
+    return (np.concatenate([r[0] for r in rem]), np.concatenate([r[1] for r in rem]),
+            np.concatenate([r[2] for r in rem]).astype(np.int64))

@@ -27,7 +27,7 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.kinematics.constants import constants
 from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_interval
-from intervalkin.paving.contracted import ASPECT_NAMES, contract_label
+from intervalkin.paving.contracted import ASPECT_NAMES, contract_labels
 from intervalkin.paving.labels import Label, and_labels, not_label
 from intervalkin.paving.tree import Paving, pave_multi, workspace_paving_domain
 
@@ -100,11 +100,13 @@ def contract_paving(geometry: Geometry, paving: Paving, refine: int = 0) -> dict
     the grid, which is left unchanged); ``refine``: bisect-and-cut rounds of the remainders.
     """
     scale = (paving.domain[:, 1] - paving.domain[:, 0]) * 2.0 ** -paving.depth
-    out = {}
-    for name in ASPECT_NAMES:
-        rows = np.flatnonzero(paving.labels[name] == Label.BOUNDARY)
-        out[name] = contract_label(geometry, name, paving.lo[rows], paving.hi[rows], rows, refine, scale)
-    return out
+    lab = paving.labels
+    rows = np.flatnonzero(np.any([lab[n] == Label.BOUNDARY for n in ASPECT_NAMES], axis=0))
+    det = lab["det_positive"][rows]
+    det_sign = np.where(det == Label.INSIDE, 1, np.where(det == Label.OUTSIDE, -1, 0)).astype(np.int8)
+    return contract_labels(geometry, paving.lo[rows], paving.hi[rows], rows,
+                           {n: lab[n][rows] == Label.BOUNDARY for n in ASPECT_NAMES},
+                           w_undecided=lab["W"][rows] == Label.BOUNDARY, det_sign=det_sign, refine=refine, scale=scale)
 
 
 def pave_workspace(geometry: Geometry, depth: int, progress=None, split=None,
