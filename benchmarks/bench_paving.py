@@ -143,6 +143,8 @@ def main() -> None:
     ap.add_argument("--depths", type=int, nargs="+", default=[5, 6, 7, 8, 9])
     ap.add_argument("--refine", type=int, nargs="+", default=[0, 1],
                     help="bisect-and-cut rounds of the contracted modes (-1 alone: grid only)")
+    ap.add_argument("--refine-max-depth", type=int, default=7,
+                    help="no bisect-and-cut rounds above this depth (a grid level is cheaper at equal gain)")
     ap.add_argument("--codac-depth", type=int, default=6)
     ap.add_argument("--codac-timeout", type=float, default=900)
     ap.add_argument("--no-codac", action="store_true")
@@ -158,7 +160,7 @@ def main() -> None:
     print(hdr, flush=True)
     rows = []
     for d in a.depths:
-        for r in sorted(set([-1] + a.refine)):
+        for r in sorted(set([-1] + [r for r in a.refine if r <= 0 or d <= a.refine_max_depth])):
             row = _child(OURS_SCRIPT, [str(d), str(r)], a.timeout)
             row.setdefault("depth", d)
             row["mode"] = "grid" if r < 0 else f"contract+{r}"

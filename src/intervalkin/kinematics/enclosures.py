@@ -55,7 +55,7 @@ from intervalkin.core.interval import Interval
 from intervalkin.kinematics.constants import KinematicConstants, constants
 from intervalkin.kinematics.formulas import det_coefficients, leg_moment, leg_rho_sq, quadratic, quadratic_gradient
 
-__all__ = ['PhiDual', 'rho_sq_interval', 'rho_interval', 'LegForms', 'rho_sq_leg_forms', 'jacobian_interval',
+__all__ = ['PhiDual', 'rho_sq_interval', 'rho_sq_leg_interval', 'rho_interval', 'LegForms', 'rho_sq_leg_forms', 'jacobian_interval',
            'det_a_interval', 'det_a_gradient_interval']
 
 #: Pieces of each phi range over which the coefficients of det A are enclosed (their hull is used).
@@ -233,22 +233,29 @@ def rho_sq_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:
     ph = _phi_ranges(b, 1)
     out = Interval(np.empty((len(b), 3)), np.empty((len(b), 3)))  # filled leg by leg (peak memory)
     for i in range(3):
-        dx, dy = _leg_offsets(k, b, i)
-        if i == 0:
-            e = leg_rho_sq(dx, dy)
-        else:
-            rx, ry = _over_phi(ph, _rotation(k, i, ph.samples))
-
-            def form(name):
-                return leg_rho_sq(dx, dy, rx.box(name), ry.box(name))
-
-            if ph.thin:
-                e = form("value")
-            else:
-                slope = leg_moment(dx, dy, rx.box("value"), ry.box("value")) * 2.0
-                e = _phi_tight(form, slope, ph.offset)
+        e = _rho_sq_leg(k, b, ph, i)
         out.lo[:, i], out.hi[:, i] = e.lo, e.hi
     return out
+
+
+def rho_sq_leg_interval(geometry: Geometry, boxes: np.ndarray, leg: int) -> Interval:
+    """Column ``leg`` of :func:`rho_sq_interval` alone (the same enclosure), Interval (n,).  Certified."""
+    b = _boxes(boxes)
+    return _rho_sq_leg(constants(geometry), b, _phi_ranges(b, 1), leg)
+
+
+def _rho_sq_leg(k: KinematicConstants, b: np.ndarray, ph: _PhiRanges, i: int) -> Interval:
+    dx, dy = _leg_offsets(k, b, i)
+    if i == 0:
+        return leg_rho_sq(dx, dy)
+    rx, ry = _over_phi(ph, _rotation(k, i, ph.samples))
+
+    def form(name):
+        return leg_rho_sq(dx, dy, rx.box(name), ry.box(name))
+
+    if ph.thin:
+        return form("value")
+    return _phi_tight(form, leg_moment(dx, dy, rx.box("value"), ry.box("value")) * 2.0, ph.offset)
 
 
 def rho_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:

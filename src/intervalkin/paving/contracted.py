@@ -299,14 +299,21 @@ def contract_labels(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, leaf: np
                 _collect(acc[nm], nxt, b_lo, b_hi, r_leaf[s:s + CHUNK], hold, fail)
             r_lo, r_hi, r_leaf = _joined(nxt)
         acc[nm].append((r_lo, r_hi, r_leaf, Label.BOUNDARY))
-        a = acc[nm]
-        out[nm] = ContractedParts(
-            leaf=np.concatenate([x[2] for x in a]).astype(np.int64),
-            lo=np.concatenate([x[0] for x in a]).reshape(-1, 3),
-            hi=np.concatenate([x[1] for x in a]).reshape(-1, 3),
-            label=np.concatenate([np.full(len(x[2]), x[3], dtype=np.uint8) for x in a]),
-        )
+        del r_lo, r_hi, r_leaf
+        out[nm] = _assembled(acc.pop(nm))
     return out
+
+
+def _assembled(pieces: list) -> ContractedParts:
+    """One ContractedParts from (lo, hi, leaf, label) pieces, freeing each field's pieces once copied."""
+    label = np.concatenate([np.full(len(x[2]), x[3], dtype=np.uint8) for x in pieces])
+    fields = [list(col) for col in zip(*[x[:3] for x in pieces])]
+    pieces.clear()
+    out = []
+    for j, cols in enumerate(fields):
+        out.append(np.concatenate(cols).reshape((-1, 3) if j < 2 else (-1,)))
+        cols.clear()
+    return ContractedParts(leaf=out[2].astype(np.int64, copy=False), lo=out[0], hi=out[1], label=label)
 
 
 def _collect(acc: list, rem: list, lo, hi, leaf, hold, fail) -> None:

@@ -36,7 +36,7 @@ import numpy as np
 
 from intervalkin.core.errors import InputError
 from intervalkin.core.interval import PI_HI
-from intervalkin.paving.labels import Label
+from intervalkin.paving.labels import Label, and_labels
 
 __all__ = ['workspace_paving_domain', 'box_bounds', 'split_boxes', 'Paving', 'pave_multi', 'pave']
 
@@ -228,6 +228,12 @@ def pave_multi(
     A child inherits its parent's labels; a predicate is re-evaluated on the child
     only where the inherited label is BOUNDARY, and the new label is ANDed (as
     flags) with the inherited one, so labels only sharpen under subdivision.
+
+    A predicate that is a conjunction of m parts may say so: an integer attribute
+    ``conjuncts`` = m and a method ``conjunct_labels(boxes, todo (k, m) bool) -> (k, m)``
+    labels of the parts asked for.  The paver then keeps each box's part labels, asks
+    a child only for the parts its parent left BOUNDARY (a part proved on a box holds
+    on its sub-boxes), and the label is the AND of the parts (:func:`and_labels`).
     """
     items = list(predicates.items()) if isinstance(predicates, Mapping) else list(predicates)
     names = [n for n, _ in items]
@@ -246,6 +252,8 @@ def pave_multi(
     level = np.zeros(1, dtype=np.int64)
     ijk = np.zeros((1, 3), dtype=np.int64)
     inherited = {n: np.full(1, Label.BOUNDARY, dtype=np.uint8) for n in names}
+    parts_of = {n: int(getattr(fn, "conjuncts", 0) or 0) for n, fn in items}
+    inherited_parts = {n: np.full((1, m), Label.BOUNDARY, dtype=np.uint8) for n, m in parts_of.items() if m}
     leaves: list[tuple] = []
     stats: list[dict] = []
     for lev in range(depth + 1):
@@ -260,8 +268,16 @@ def pave_multi(
             if name in relevant:
                 todo &= relevant[name](labels)
             idx = np.flatnonzero(todo)
-            if idx.size:
+            if idx.size and parts_of[name]:
+                parts = inherited_parts[name]
+                sharp_parts = parts[idx] & np.asarray(fn.conjunct_labels(boxes[idx], parts[idx] == Label.BOUNDARY),
+                                                      dtype=np.uint8)
+                assert np.all(sharp_parts != Label.CONTRADICTION), f"{name}: contradictory part labels (unsound evaluation)"
+                parts[idx] = sharp_parts
+                new = functools.reduce(and_labels, [sharp_parts[:, j] for j in range(parts_of[name])])
+            elif idx.size:
                 new = np.asarray(fn(boxes[idx]), dtype=np.uint8)
+            if idx.size:
                 sharp = lab[idx] & new
                 assert np.all(sharp != Label.CONTRADICTION), f"{name}: contradictory labels (unsound evaluation)"
                 lab[idx] = sharp
@@ -286,6 +302,7 @@ def pave_multi(
             break
         level, ijk = split_boxes(level[cut], ijk[cut])
         inherited = {n: np.repeat(labels[n][cut], 8) for n in names}
+        inherited_parts = {n: np.repeat(v[cut], 8, axis=0) for n, v in inherited_parts.items()}
         del boxes, lo, hi
     out_labels = {n: np.concatenate([lf[4][n] for lf in leaves]) for n in names}
     return Paving(
