@@ -55,8 +55,8 @@ from intervalkin.core.interval import Interval
 from intervalkin.kinematics.constants import KinematicConstants, constants
 from intervalkin.kinematics.formulas import det_coefficients, leg_moment, leg_rho_sq, quadratic, quadratic_gradient
 
-__all__ = ['PhiDual', 'rho_sq_interval', 'rho_sq_leg_interval', 'rho_interval', 'LegForms', 'rho_sq_leg_forms', 'jacobian_interval',
-           'det_a_interval', 'det_a_gradient_interval']
+__all__ = ['PhiDual', 'rho_sq_interval', 'rho_sq_leg_interval', 'rho_interval', 'LegForms', 'rho_sq_leg_forms',
+           'jacobian_interval', 'det_a_interval', 'det_a_gradient_interval']
 
 #: Pieces of each phi range over which the coefficients of det A are enclosed (their hull is used).
 DET_PHI_PIECES = 8

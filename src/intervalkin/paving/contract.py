@@ -171,7 +171,8 @@ def contract_det(geometry: Geometry, lo: np.ndarray, hi: np.ndarray,
     grad = det_a_gradient_interval(geometry, boxes)
     d = [_axis(lo, hi, j) - m[:, j] for j in range(3)]
     terms = [grad[:, j] * d[j] for j in range(3)]
-    target = Interval(np.float64(0.0), np.float64(np.inf)) if sign > 0 else Interval(np.float64(-np.inf), np.float64(0.0))
+    t_lo, t_hi = (0.0, np.inf) if sign > 0 else (-np.inf, 0.0)
+    target = Interval(np.float64(t_lo), np.float64(t_hi))
     s, empty = _meet(fm + terms[0] + terms[1] + terms[2], target)
     for j in range(3):
         others = [terms[i] for i in range(3) if i != j]

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import round_down, round_up
 from intervalkin.kinematics.constants import constants
@@ -254,7 +255,7 @@ def contract_label(geometry: Geometry, name: str, lo: np.ndarray, hi: np.ndarray
     Returns the parts, which tile the boxes.  Certified (module docstring).
     """
     if name not in ASPECT_NAMES:
-        raise ValueError(f"name: expected one of {ASPECT_NAMES}, got {name!r}")
+        raise InputError(f"name: expected one of {ASPECT_NAMES}, got {name!r}")
     n = len(lo)
     return contract_labels(geometry, lo, hi, leaf, {name: np.ones(n, dtype=bool)}, refine=refine, scale=scale)[name]
 
@@ -280,8 +281,9 @@ def contract_labels(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, leaf: np
         for nm in names:
             any_row |= rows_of[nm][sl]
         sel = np.flatnonzero(any_row)
-        cuts = _cuts(geometry, names, lo[sl][sel], hi[sl][sel],
-                     None if w_undecided is None else w_undecided[sl][sel], None if det_sign is None else det_sign[sl][sel])
+        known_w = None if w_undecided is None else w_undecided[sl][sel]
+        known_det = None if det_sign is None else det_sign[sl][sel]
+        cuts = _cuts(geometry, names, lo[sl][sel], hi[sl][sel], known_w, known_det)
         for nm in names:
             mine = rows_of[nm][sl][sel]
             hold, fail = (tuple(a[mine] for a in box) for box in cuts[nm])

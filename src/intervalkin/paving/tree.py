@@ -272,7 +272,7 @@ def pave_multi(
                 parts = inherited_parts[name]
                 sharp_parts = parts[idx] & np.asarray(fn.conjunct_labels(boxes[idx], parts[idx] == Label.BOUNDARY),
                                                       dtype=np.uint8)
-                assert np.all(sharp_parts != Label.CONTRADICTION), f"{name}: contradictory part labels (unsound evaluation)"
+                assert np.all(sharp_parts != Label.CONTRADICTION), f"{name}: contradictory part labels (unsound)"
                 parts[idx] = sharp_parts
                 new = functools.reduce(and_labels, [sharp_parts[:, j] for j in range(parts_of[name])])
             elif idx.size:
