@@ -272,3 +272,32 @@ def test_mutation_shrinking_contractor_is_caught(monkeypatch, ulps):
         p = pave_workspace(GEOMETRIES["paper"], 3, contract=True)
         bad, _ = _part_violations("paper", p.parts, np.random.default_rng(3))
         assert bad
+
+
+def test_mutation_contractor_without_outward_rounding_is_caught(monkeypatch):
+    """rho_min = 10.059, A1 = (0.3, 0): a box thin in y and phi across the circle rho_1 = rho_min.  Without
+    the one-ulp widening of the cut the parts are still sound (the contractor rounds outward); with the
+    outward rounding of the interval layer switched off as well, the INSIDE part starts inside the circle,
+    and exact rational arithmetic sees it."""
+    import intervalkin.core.interval as interval_module
+
+    g = _limit_geometry("10.059")
+    x = float(decimal.Decimal("10.359"))  # 0.3 + 10.059: the circle crosses the box's middle
+    lo, hi = np.array([[x - 0.05, 0.0, 0.25]]), np.array([[x + 0.05, 0.0, 0.25]])
+    r2 = (fmpq(10059, 1000)) ** 2
+
+    def inside_part_starts_inside_the_circle() -> bool:
+        parts = contract_label(g, "W", lo, hi, np.array([0]))
+        start = parts.lo[parts.label == Label.INSIDE, 0].min()
+        return (fmpq(*float(start).as_integer_ratio()) - fmpq(3, 10)) ** 2 < r2
+
+    monkeypatch.setattr(contracted_module, "_widen", lambda b_lo, b_hi, c_lo, c_hi: (np.maximum(c_lo, b_lo),
+                                                                                      np.minimum(c_hi, b_hi)))
+    assert not inside_part_starts_inside_the_circle()
+
+    def unrounded(v):
+        return np.asarray(v, dtype=np.float64)
+
+    monkeypatch.setattr(interval_module, "round_down", unrounded)
+    monkeypatch.setattr(interval_module, "round_up", unrounded)
+    assert inside_part_starts_inside_the_circle()
