@@ -1,14 +1,18 @@
-"""Benchmark of the workspace paving (a script, not a test).
+"""Benchmark of the workspace paving against Codac 2, in one run (a script, not a test).
 
-    python benchmarks/bench_paving.py [--max-depth 8] [--with-9] [--codac-max-depth 6] [--no-codac]
+    python benchmarks/bench_paving.py [--depths 5 6 7 8 9] [--refine 0 1] [--codac-depth 6] [--no-codac] [--json F]
 
-Per depth: boxes evaluated, boxes/s, wall time, peak memory (tracemalloc for numpy
-buffers, plus ru_maxrss of the process), inside / undecided volumes of W and of each
-aspect, number of components, and inner-volume ratios against a seeded Monte Carlo
-estimate of the true volumes.  Codac 2 (``pip install codac``) paves the same sets
-in a SEPARATE process (importing codac switches the process to upward rounding):
-phi is rescaled so that all axes have width 64 and Codac's bisection of the largest
-side reproduces the octree resolution 64 / 2**depth on every axis.
+Per depth and per mode (``grid``: the octree alone; ``contract+r``: its undecided leaves cut
+by the contractors with r bisect-and-cut rounds, :mod:`intervalkin.paving.contracted`): boxes
+(grid leaves, contracted parts), seconds (paving, contraction), peak memory (the ru_maxrss
+of a fresh process per row), inner volumes of W, WA1 and WA2 as fractions of seeded Monte
+Carlo volumes, and the undecided volume.  Codac 2 (the optional ``bench`` extra:
+``pip install codac``; never a dependency of the library) paves the same three sets with
+``SepInverse`` (+ ``SepInter`` for the aspects) in SEPARATE processes (importing codac
+switches the process to upward rounding): phi is rescaled so that all axes have width 64 and
+bisection down to 64 / 2**d reproduces the octree resolution of depth d.  The last lines
+compare: the first of our rows whose inner volumes reach Codac's for all three sets, and its
+time as a fraction of Codac's.
 """
 
 from __future__ import annotations
@@ -16,19 +20,16 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import resource
 import subprocess
 import sys
 import time
-import tracemalloc
 
 import numpy as np
 
-from intervalkin.core.geometry import default_geometry
-from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
-from intervalkin.paving.adjacency import shares_face
-from intervalkin.space.aspect import aspect_components
-from intervalkin.paving.predicates import pave_workspace
+HERE = os.path.dirname(os.path.abspath(__file__))
+SETS = ("W", "WA1", "WA2")
 
 CODAC_SCRIPT = r'''
 import sys, time, json, math
@@ -59,128 +60,150 @@ el = time.perf_counter() - t
 def vol(boxes):
     return sum(b[0].diam() * b[1].diam() * b[2].diam() * k for b in boxes)
 inner = p.boxes(PavingInOut.inner); bound = p.boxes(PavingInOut.bound)
-out = {"seconds": el, "inner_volume": vol(inner), "boundary_volume": vol(bound), "inner_boxes": len(inner), "boundary_boxes": len(bound)}
-try:
-    cs = p.connected_subsets(PavingInOut.inner)
-    out["components_all"] = len(cs)
-except Exception as e:
-    out["components_all"] = str(e)
-print(json.dumps(out))
+import resource
+print(json.dumps({"seconds": el, "inner_volume": vol(inner), "boundary_volume": vol(bound),
+                  "inner_boxes": len(inner), "boundary_boxes": len(bound),
+                  "maxrss_MiB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+'''
+
+OURS_SCRIPT = r'''
+import json, resource, sys, time
+from intervalkin.core.geometry import default_geometry
+from intervalkin.paving.predicates import contract_paving, pave_workspace
+depth, refine = int(sys.argv[1]), int(sys.argv[2])
+g = default_geometry()
+pave_workspace(g, 3, contract=refine >= 0)  # warm-up: imports, constant caches
+t = time.perf_counter()
+p = pave_workspace(g, depth)
+t_pave = time.perf_counter() - t
+row = {"depth": depth, "refine": refine, "leaves": len(p), "evaluated": sum(s["boxes"] for s in p.stats),
+       "paving_s": t_pave, "contract_s": 0.0, "parts": 0}
+if refine >= 0:
+    t = time.perf_counter()
+    p.parts.update(contract_paving(g, p, refine))
+    row["contract_s"] = time.perf_counter() - t
+    row["parts"] = sum(len(v) for v in p.parts.values())
+row["seconds"] = row["paving_s"] + row["contract_s"]
+for name in ("W", "WA1", "WA2"):
+    v = p.volume_by_label(name, contracted=refine >= 0)
+    row[name + "_in"], row[name + "_und"] = v["inside"], v["boundary"]
+row["maxrss_MiB"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+print(json.dumps(row))
 '''
 
 
-def monte_carlo(geometry, n=4_000_000, seed=12345):
+def monte_carlo(n: int = 4_000_000, seed: int = 12345) -> dict[str, float]:
     """Float (not certified) estimates of vol(W), vol(WA1), vol(WA2): the reference."""
+    from intervalkin.core.geometry import default_geometry
+    from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
+
+    g = default_geometry()
     rng = np.random.default_rng(seed)
     dom = np.array([[-32, 32], [-32, 32], [-math.pi, math.pi]])
-    V = float(np.prod(dom[:, 1] - dom[:, 0]))
+    vol = float(np.prod(dom[:, 1] - dom[:, 0]))
     acc = np.zeros(3)
     chunk = 1_000_000
     for _ in range(n // chunk):
         X = rng.uniform(dom[:, 0], dom[:, 1], (chunk, 3))
-        rho = approx_inverse_kinematics(geometry, X)
+        rho = approx_inverse_kinematics(g, X)
         w = np.all((rho >= 10) & (rho <= 32), axis=1)
-        d = approx_det_a(geometry, X)
+        d = approx_det_a(g, X)
         acc += [w.sum(), (w & (d > 0)).sum(), (w & (d < 0)).sum()]
-    est = acc / n * V
-    return dict(zip(("W", "WA1", "WA2"), est.tolist()))
+    return dict(zip(SETS, (acc / n * vol).tolist()))
 
 
-def run_ours(geometry, depth):
-    tracemalloc.start()
-    t = time.perf_counter()
-    p = pave_workspace(geometry, depth)
-    t_pave = time.perf_counter() - t
-    edges = shares_face(p.level, p.ijk, p.depth)
-    aspect, info = aspect_components(p, edges)
-    wall = time.perf_counter() - t
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    evaluated = sum(s["boxes"] for s in p.stats)
-    row = {
-        "depth": depth,
-        "boxes_evaluated": evaluated,
-        "leaves": len(p),
-        "boxes_per_s": evaluated / t_pave,
-        "paving_s": t_pave,
-        "wall_s": wall,
-        "peak_traced_MiB": peak / 2**20,
-        "maxrss_MiB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-    }
-    for name in ("W", "WA1", "WA2"):
-        v = p.volume_by_label(name)
-        row[f"{name}_in"] = v["inside"]
-        row[f"{name}_und"] = v["boundary"]
-    row["comp_WA1"] = sum(1 for d in info if d["sign"] > 0)
-    row["comp_WA2"] = sum(1 for d in info if d["sign"] < 0)
-    row["comp_big"] = sum(1 for d in info if d["volume"] > 100)
-    return row
+def _child(code: str, args: list[str], timeout: float) -> dict:
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.join(HERE, "..", "src"), os.environ.get("PYTHONPATH", "")]))
+    try:
+        r = subprocess.run([sys.executable, "-c", code] + args, capture_output=True, text=True, timeout=timeout, env=env)
+    except subprocess.TimeoutExpired:
+        return {"error": f"timeout {timeout} s"}
+    if r.returncode != 0:
+        return {"error": r.stderr.strip().splitlines()[-1] if r.stderr.strip() else f"exit {r.returncode}"}
+    return json.loads(r.stdout.strip().splitlines()[-1])
 
 
-def run_codac(geometry, depth, timeout):
+def run_codac(depth: int, timeout: float) -> dict:
+    from intervalkin.core.geometry import default_geometry
+
+    g = default_geometry()
+    args = [str(depth), "", str(float(g.p3x)), str(float(g.p3y)), str(float(g.l2))]
     out = {}
-    args = [str(float(geometry.p3x)), str(float(geometry.p3y)), str(float(geometry.l2))]
-    for which in ("W", "WA1", "WA2"):
-        try:
-            r = subprocess.run([sys.executable, "-c", CODAC_SCRIPT, str(depth), which] + args,
-                               capture_output=True, text=True, timeout=timeout)
-            out[which] = json.loads(r.stdout.strip().splitlines()[-1]) if r.returncode == 0 else {"error": r.stderr[-300:]}
-        except subprocess.TimeoutExpired:
-            out[which] = {"error": f"timeout {timeout} s"}
+    for which in SETS:
+        args[1] = which
+        out[which] = _child(CODAC_SCRIPT, args, timeout)
+    ok = all("seconds" in out[k] for k in SETS)
+    out["seconds"] = sum(out[k]["seconds"] for k in SETS) if ok else float("nan")
+    out["maxrss_MiB"] = max(out[k].get("maxrss_MiB", 0) for k in SETS)
     return out
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--min-depth", type=int, default=4)
-    ap.add_argument("--max-depth", type=int, default=8)
-    ap.add_argument("--with-9", action="store_true", help="also depth 9")
-    ap.add_argument("--codac-max-depth", type=int, default=6)
-    ap.add_argument("--codac-timeout", type=float, default=600)
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--depths", type=int, nargs="+", default=[5, 6, 7, 8, 9])
+    ap.add_argument("--refine", type=int, nargs="+", default=[0, 1],
+                    help="bisect-and-cut rounds of the contracted modes (-1 alone: grid only)")
+    ap.add_argument("--refine-max-depth", type=int, default=7,
+                    help="no bisect-and-cut rounds above this depth (a grid level is cheaper at equal gain)")
+    ap.add_argument("--codac-depth", type=int, default=6)
+    ap.add_argument("--codac-timeout", type=float, default=900)
     ap.add_argument("--no-codac", action="store_true")
+    ap.add_argument("--timeout", type=float, default=600)
     ap.add_argument("--json", metavar="FILE")
     a = ap.parse_args()
-    g = default_geometry()
-    mc = monte_carlo(g)
-    print("Monte Carlo reference volumes (4e6 samples, float, seed 12345): "
-          + ", ".join(f"{k} {v:.1f}" for k, v in mc.items()))
-    depths = list(range(a.min_depth, a.max_depth + 1)) + ([9] if a.with_9 and a.max_depth < 9 else [])
+
+    mc = monte_carlo()
+    print("Monte Carlo volumes (4e6 float samples, seed 12345): " + ", ".join(f"{k} {v:.1f}" for k, v in mc.items()))
+    print(f"cores: {os.cpu_count()}; each row in a fresh process (peak memory = its max RSS)\n")
+    hdr = (f"{'d':>2} {'mode':>10} {'leaves':>9} {'parts':>9} {'pave s':>7} {'cut s':>6} {'total s':>7} {'MiB':>6} "
+           + " ".join(f"{k + ' in%':>7} {k + ' und':>8}" for k in SETS))
+    print(hdr, flush=True)
     rows = []
-    hdr = (f"{'d':>2} {'evaluated':>10} {'boxes/s':>9} {'wall s':>7} {'peakMiB':>8} {'rssMiB':>7} "
-           f"{'W in%':>6} {'W und':>8} {'WA1 in%':>7} {'WA1 und':>8} {'WA2 in%':>7} {'WA2 und':>8} {'comp+':>5} {'comp-':>5}")
-    print(hdr)
-    for d in depths:
-        r = run_ours(g, d)
-        for k in ("W", "WA1", "WA2"):
-            r[f"{k}_ratio"] = r[f"{k}_in"] / mc[k]
-        rows.append(r)
-        print(f"{d:>2} {r['boxes_evaluated']:>10} {r['boxes_per_s']:>9.0f} {r['wall_s']:>7.2f} {r['peak_traced_MiB']:>8.0f} "
-              f"{r['maxrss_MiB']:>7.0f} {100 * r['W_ratio']:>6.1f} {r['W_und']:>8.1f} {100 * r['WA1_ratio']:>7.1f} "
-              f"{r['WA1_und']:>8.1f} {100 * r['WA2_ratio']:>7.1f} {r['WA2_und']:>8.1f} {r['comp_WA1']:>5} {r['comp_WA2']:>5}", flush=True)
-    codac = {}
-    if not a.no_codac:
-        print("\nCodac 2 (separate process, SepInverse + SepInter, pave with eps = 64/2**d on rescaled axes)")
-        print(f"{'d':>2} {'set':>4} {'codac s':>8} {'ours s':>7} {'ratio':>6} {'codac in':>9} {'ours in':>8} "
-              f"{'codac und':>9} {'ours und':>8} {'codac comp':>10} {'ours comp':>9}")
-        for r in rows:
-            d = r["depth"]
-            if d > a.codac_max_depth:
+    for d in a.depths:
+        for r in sorted(set([-1] + [r for r in a.refine if r <= 0 or d <= a.refine_max_depth])):
+            row = _child(OURS_SCRIPT, [str(d), str(r)], a.timeout)
+            row.setdefault("depth", d)
+            row["mode"] = "grid" if r < 0 else f"contract+{r}"
+            rows.append(row)
+            if "error" in row:
+                print(f"{d:>2} {row['mode']:>10} {row['error']}", flush=True)
                 continue
-            c = run_codac(g, d, a.codac_timeout)
-            codac[d] = c
-            total = sum(c[k].get("seconds", float("nan")) for k in c)
-            for k in ("W", "WA1", "WA2"):
-                ck = c[k]
-                if "error" in ck:
-                    print(f"{d:>2} {k:>4} {ck['error']}")
+            print(f"{d:>2} {row['mode']:>10} {row['leaves']:>9} {row['parts']:>9} {row['paving_s']:>7.2f} "
+                  f"{row['contract_s']:>6.2f} {row['seconds']:>7.2f} {row['maxrss_MiB']:>6.0f} "
+                  + " ".join(f"{100 * row[k + '_in'] / mc[k]:>7.1f} {row[k + '_und']:>8.1f}" for k in SETS), flush=True)
+    codac = None
+    if not a.no_codac:
+        codac = run_codac(a.codac_depth, a.codac_timeout)
+        print(f"\nCodac 2, depth {a.codac_depth} (SepInverse / SepInter, separate processes)")
+        for k in SETS:
+            c = codac[k]
+            if "error" in c:
+                print(f"  {k:>3}: {c['error']}")
+            else:
+                print(f"  {k:>3}: {c['seconds']:7.2f} s  inner {100 * c['inner_volume'] / mc[k]:5.1f} %  "
+                      f"undecided {c['boundary_volume']:8.1f}  boxes {c['inner_boxes'] + c['boundary_boxes']}  "
+                      f"{c['maxrss_MiB']:.0f} MiB")
+        if math.isfinite(codac["seconds"]):
+            print(f"  all: {codac['seconds']:7.2f} s (W + both aspects, three pavings)\n")
+            print("Ours against Codac: inner volume ratio per set, time ratio (Codac s / ours s)")
+            first = None
+            for row in rows:
+                if "error" in row:
                     continue
-                ours_comp = {"W": "-", "WA1": r["comp_WA1"], "WA2": r["comp_WA2"]}[k]
-                print(f"{d:>2} {k:>4} {ck['seconds']:>8.2f} {'':>7} {'':>6} {ck['inner_volume']:>9.1f} {r[k + '_in']:>8.1f} "
-                      f"{ck['boundary_volume']:>9.1f} {r[k + '_und']:>8.1f} {str(ck['components_all']):>10} {str(ours_comp):>9}")
-            print(f"{d:>2} {'all':>4} {total:>8.2f} {r['paving_s']:>7.2f} {total / r['paving_s']:>6.0f}x  (W + aspects, ours in one pass)")
+                ratios = [row[k + "_in"] / codac[k]["inner_volume"] for k in SETS]
+                speed = codac["seconds"] / row["seconds"]
+                ok = all(x >= 1 for x in ratios)
+                print(f"{row['depth']:>2} {row['mode']:>10}  " + "  ".join(f"{k} {x:5.3f}" for k, x in zip(SETS, ratios))
+                      + f"   {speed:7.1f}x faster" + ("   >= Codac on all three" if ok else ""))
+                if ok and (first is None or row["seconds"] < first["seconds"]):
+                    first = row
+            if first is not None:
+                print(f"\nFastest row at or above Codac's inner volume on W, WA1 and WA2: depth {first['depth']} "
+                      f"{first['mode']}, {first['seconds']:.2f} s = 1/{codac['seconds'] / first['seconds']:.0f} of Codac's "
+                      f"{codac['seconds']:.1f} s")
     if a.json:
         with open(a.json, "w") as f:
-            json.dump({"monte_carlo": mc, "ours": rows, "codac": codac}, f, indent=1)
+            json.dump({"monte_carlo": mc, "ours": rows, "codac": codac, "cores": os.cpu_count()}, f, indent=1)
 
 
 if __name__ == "__main__":

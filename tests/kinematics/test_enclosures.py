@@ -250,3 +250,25 @@ def test_constants_are_cached_by_identity(paper_geometry):
         lo, hi = k.rho_min_sq_iv.lo[i], k.rho_min_sq_iv.hi[i]
         v = paper_geometry.rho_min[i] ** 2
         assert Fraction(lo) <= v <= Fraction(hi)
+
+
+@pytest.mark.parametrize("geometry_file", [None, "offset_right.toml"])
+def test_leg_forms_enclose_arb_values(paper_geometry, geometry_file):
+    """rho_i^2 at points of a box lies in the natural form and in the centred-in-phi form of rho_sq_leg_forms."""
+    from intervalkin.kinematics.enclosures import rho_sq_leg_forms
+
+    g = paper_geometry if geometry_file is None else load_geometry(DATA / geometry_file)
+    rng = np.random.default_rng(12)
+    boxes = _random_boxes(rng, 120, [2.0**-3, 2.0**-7, 2.0**-12])
+    pts = _points_in(rng, boxes, 2)
+    for leg in range(3):
+        f = rho_sq_leg_forms(g, boxes, leg)
+        assert np.all((boxes[:, 2, 0] <= f.phi_mid) & (f.phi_mid <= boxes[:, 2, 1]))
+        for p in pts:
+            x, y = Interval.point(p[:, 0]), Interval.point(p[:, 1])
+            natural = (x + f.cx).sqr() + (y + f.cy).sqr()
+            centred = (x + f.cx_mid).sqr() + (y + f.cy_mid).sqr() + f.slope * (Interval.point(p[:, 2]) - f.phi_mid)
+            for k in range(len(boxes)):
+                exact = rho_sq_arb(g, *(arb(float(v)) for v in p[k]))[leg]
+                for e in (natural, centred):
+                    assert not (exact < arb(float(e.lo[k])) or exact > arb(float(e.hi[k])))

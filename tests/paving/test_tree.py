@@ -266,3 +266,24 @@ def test_locate_boxes_matches_brute_force(paper_geometry):
             assert idx[k] in holders
         else:
             assert holders.size == 0
+
+
+def test_conjunct_parts_are_kept_and_labels_unchanged(monkeypatch):
+    """W as three legs: the paver asks a child only for the legs its parent left open, and the labels
+    are those of the paver that re-evaluates all three legs on every box."""
+    from intervalkin.paving import predicates
+
+    asked = []
+    real = predicates.WorkspacePredicate.conjunct_labels
+
+    def spy(self, boxes, todo):
+        asked.append((len(todo), int(todo.sum())))
+        return real(self, boxes, todo)
+
+    monkeypatch.setattr(predicates.WorkspacePredicate, "conjunct_labels", spy)
+    kept = pave_workspace(GEOM, 6)
+    monkeypatch.setattr(predicates.WorkspacePredicate, "conjuncts", 0)
+    plain = pave_workspace(GEOM, 6)
+    assert len(kept) == len(plain) and all(np.array_equal(kept.labels[n], plain.labels[n]) for n in plain.labels)
+    boxes, legs = np.sum(asked, axis=0)
+    assert legs < 0.6 * 3 * boxes, "children re-evaluated the legs their parents had decided"

@@ -55,8 +55,8 @@ from intervalkin.core.interval import Interval
 from intervalkin.kinematics.constants import KinematicConstants, constants
 from intervalkin.kinematics.formulas import det_coefficients, leg_moment, leg_rho_sq, quadratic, quadratic_gradient
 
-__all__ = ['PhiDual', 'rho_sq_interval', 'rho_interval', 'jacobian_interval', 'det_a_interval',
-           'det_a_gradient_interval']
+__all__ = ['PhiDual', 'rho_sq_interval', 'rho_sq_leg_interval', 'rho_interval', 'LegForms', 'rho_sq_leg_forms',
+           'jacobian_interval', 'det_a_interval', 'det_a_gradient_interval']
 
 #: Pieces of each phi range over which the coefficients of det A are enclosed (their hull is used).
 DET_PHI_PIECES = 8
@@ -233,27 +233,76 @@ def rho_sq_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:
     ph = _phi_ranges(b, 1)
     out = Interval(np.empty((len(b), 3)), np.empty((len(b), 3)))  # filled leg by leg (peak memory)
     for i in range(3):
-        dx, dy = _leg_offsets(k, b, i)
-        if i == 0:
-            e = leg_rho_sq(dx, dy)
-        else:
-            rx, ry = _over_phi(ph, _rotation(k, i, ph.samples))
-
-            def form(name):
-                return leg_rho_sq(dx, dy, rx.box(name), ry.box(name))
-
-            if ph.thin:
-                e = form("value")
-            else:
-                slope = leg_moment(dx, dy, rx.box("value"), ry.box("value")) * 2.0
-                e = _phi_tight(form, slope, ph.offset)
+        e = _rho_sq_leg(k, b, ph, i)
         out.lo[:, i], out.hi[:, i] = e.lo, e.hi
     return out
+
+
+def rho_sq_leg_interval(geometry: Geometry, boxes: np.ndarray, leg: int) -> Interval:
+    """Column ``leg`` of :func:`rho_sq_interval` alone (the same enclosure), Interval (n,).  Certified."""
+    b = _boxes(boxes)
+    return _rho_sq_leg(constants(geometry), b, _phi_ranges(b, 1), leg)
+
+
+def _rho_sq_leg(k: KinematicConstants, b: np.ndarray, ph: _PhiRanges, i: int) -> Interval:
+    dx, dy = _leg_offsets(k, b, i)
+    if i == 0:
+        return leg_rho_sq(dx, dy)
+    rx, ry = _over_phi(ph, _rotation(k, i, ph.samples))
+
+    def form(name):
+        return leg_rho_sq(dx, dy, rx.box(name), ry.box(name))
+
+    if ph.thin:
+        return form("value")
+    return _phi_tight(form, leg_moment(dx, dy, rx.box("value"), ry.box("value")) * 2.0, ph.offset)
 
 
 def rho_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:
     """Enclosures of rho_i = |B_i - A_i| over each box (square root of :func:`rho_sq_interval`), (n, 3)."""
     return rho_sq_interval(geometry, boxes).sqrt()
+
+
+@dataclass(frozen=True, eq=False)
+class LegForms:
+    """rho_i^2 = (x + c_x(phi))^2 + (y + c_y(phi))^2, c_i(phi) = r_i(phi) - A_i, in the pieces a contractor uses.
+
+    Natural form: ``cx``, ``cy`` enclose c_i over [phi].  Centred form in phi: for every
+    point (x, y, phi) of box k there is a slope s in ``slope[k]`` (an enclosure of
+    d rho_i^2 / d phi = 2 w_i over the box) with
+    rho_i^2(x, y, phi) = (x + c_x(phi_m))^2 + (y + c_y(phi_m))^2 + s (phi - phi_m),
+    where ``phi_mid[k]`` is phi_m, a float of [phi], and ``cx_mid``, ``cy_mid`` enclose c_i(phi_m).
+    All Interval arrays have shape (n,).  Leg 1 (p_1 = 0) has thin c and a zero slope.
+    """
+
+    cx: Interval
+    cy: Interval
+    cx_mid: Interval
+    cy_mid: Interval
+    phi_mid: np.ndarray
+    slope: Interval
+
+
+def rho_sq_leg_forms(geometry: Geometry, boxes: np.ndarray, leg: int) -> LegForms:
+    """The natural and centred-in-phi pieces of rho_leg^2 over each box (see :class:`LegForms`).
+
+    One trig evaluation per box (no sharing of phi ranges: a contractor's boxes are off the
+    grid).  Certified: each piece encloses its exact counterpart.
+    """
+    b = _boxes(boxes)
+    k = constants(geometry)
+    n = len(b)
+    phi = Interval(b[:, 2, 0], b[:, 2, 1])
+    pm = phi.mid()
+    zero = Interval.point(np.zeros(n))
+    if leg == 0:
+        cx, cy = zero - k.ax_iv[0], zero - k.ay_iv[0]
+        return LegForms(cx, cy, cx, cy, pm, zero)
+    rx, ry = _rotation(k, leg, phi)
+    rxm, rym = _rotation(k, leg, Interval.point(pm))
+    dx, dy = _leg_offsets(k, b, leg)
+    slope = leg_moment(dx, dy, rx.v, ry.v) * 2.0
+    return LegForms(rx.v - k.ax_iv[leg], ry.v - k.ay_iv[leg], rxm.v - k.ax_iv[leg], rym.v - k.ay_iv[leg], pm, slope)
 
 
 def jacobian_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:

@@ -5,4 +5,6 @@ labels      OUTSIDE / INSIDE / BOUNDARY as bit flags, and how sound labels combi
 adjacency   face adjacency (phi seam included) and connected components, in bulk
 budget      the depth range and the memory estimate checked before any work
 predicates  W (joint limits), the sign of det A and the aspects as labels over arrays of boxes
+contract    forward-backward (HC4) contractors for the joint limits and the sign of det A
+contracted  undecided leaves cut by the contractors into parts proved INSIDE / OUTSIDE, beside the grid
 """

@@ -26,11 +26,12 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.kinematics.constants import constants
-from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_interval
+from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_interval, rho_sq_leg_interval
+from intervalkin.paving.contracted import ASPECT_NAMES, contract_labels
 from intervalkin.paving.labels import Label, and_labels, not_label
 from intervalkin.paving.tree import Paving, pave_multi, workspace_paving_domain
 
-__all__ = ['workspace_labels', 'det_sign_labels', 'aspect_labels', 'workspace_predicate', 'det_sign_predicate', 'and_predicates', 'not_predicate', 'aspect_predicate', 'pave_workspace']
+__all__ = ['WorkspacePredicate', 'workspace_labels', 'det_sign_labels', 'aspect_labels', 'workspace_predicate', 'det_sign_predicate', 'and_predicates', 'not_predicate', 'aspect_predicate', 'contract_paving', 'pave_workspace']
 
 
 # --------------------------------------------------------------------------------------
@@ -38,16 +39,49 @@ __all__ = ['workspace_labels', 'det_sign_labels', 'aspect_labels', 'workspace_pr
 # --------------------------------------------------------------------------------------
 def workspace_labels(geometry: Geometry, boxes: np.ndarray) -> np.ndarray:
     """W: rho_min_i <= rho_i <= rho_max_i for i = 1, 2, 3 (the AND of the three legs)."""
-    k = constants(geometry)
     r = rho_sq_interval(geometry, boxes)
     lab = None
     for i in range(3):
-        lo, hi = r.lo[:, i], r.hi[:, i]
-        leg = np.full(lo.shape, Label.BOUNDARY, dtype=np.uint8)
-        leg[(lo >= k.rho_min_sq_iv.hi[i]) & (hi <= k.rho_max_sq_iv.lo[i])] = Label.INSIDE
-        leg[(hi < k.rho_min_sq_iv.lo[i]) | (lo > k.rho_max_sq_iv.hi[i])] = Label.OUTSIDE
+        leg = _leg_label(geometry, r.lo[:, i], r.hi[:, i], i)
         lab = leg if lab is None else and_labels(lab, leg)
     return lab
+
+
+def _leg_label(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, i: int) -> np.ndarray:
+    """Leg i's limits as a label, from an enclosure [lo, hi] of rho_i^2."""
+    k = constants(geometry)
+    leg = np.full(lo.shape, Label.BOUNDARY, dtype=np.uint8)
+    leg[(lo >= k.rho_min_sq_iv.hi[i]) & (hi <= k.rho_max_sq_iv.lo[i])] = Label.INSIDE
+    leg[(hi < k.rho_min_sq_iv.lo[i]) | (lo > k.rho_max_sq_iv.hi[i])] = Label.OUTSIDE
+    return leg
+
+
+class WorkspacePredicate:
+    """W as a predicate of the paver, and as the conjunction of its three legs' limits.
+
+    ``pred(boxes)`` is :func:`workspace_labels`.  ``conjunct_labels(boxes, todo)`` labels
+    only the legs asked for (``todo`` (n, 3) bool; the others come back BOUNDARY), so
+    that the paver, which keeps each box's leg labels, re-evaluates in a child only the
+    legs its parent left undecided (a sub-box of a box inside a leg's limits is inside
+    them too): near the boundary of W usually one leg instead of three.
+    """
+
+    conjuncts = 3
+
+    def __init__(self, geometry: Geometry):
+        self.geometry = geometry
+
+    def __call__(self, boxes: np.ndarray) -> np.ndarray:
+        return workspace_labels(self.geometry, boxes)
+
+    def conjunct_labels(self, boxes: np.ndarray, todo: np.ndarray) -> np.ndarray:
+        out = np.full(todo.shape, Label.BOUNDARY, dtype=np.uint8)
+        for i in range(3):
+            rows = np.flatnonzero(todo[:, i])
+            if rows.size:
+                e = rho_sq_leg_interval(self.geometry, boxes[rows], i)
+                out[rows, i] = _leg_label(self.geometry, e.lo, e.hi, i)
+        return out
 
 
 def det_sign_labels(geometry: Geometry, boxes: np.ndarray) -> np.ndarray:
@@ -69,8 +103,8 @@ def aspect_labels(w: np.ndarray, det_positive: np.ndarray) -> tuple[np.ndarray, 
     return and_labels(w, det_positive), and_labels(w, not_label(det_positive))
 
 
-def workspace_predicate(geometry: Geometry):
-    return lambda boxes: workspace_labels(geometry, boxes)
+def workspace_predicate(geometry: Geometry) -> WorkspacePredicate:
+    return WorkspacePredicate(geometry)
 
 
 def det_sign_predicate(geometry: Geometry):
@@ -92,7 +126,24 @@ def aspect_predicate(geometry: Geometry, sign: int):
     return and_predicates(workspace_predicate(geometry), d if sign > 0 else not_predicate(d))
 
 
-def pave_workspace(geometry: Geometry, depth: int, progress=None, split=None) -> Paving:
+def contract_paving(geometry: Geometry, paving: Paving, refine: int = 0) -> dict:
+    """Cut the BOUNDARY leaves of W, WA1 and WA2 into parts proved INSIDE / OUTSIDE.
+
+    Returns name -> :class:`~intervalkin.paving.contracted.ContractedParts` (stored beside
+    the grid, which is left unchanged); ``refine``: bisect-and-cut rounds of the remainders.
+    """
+    scale = (paving.domain[:, 1] - paving.domain[:, 0]) * 2.0 ** -paving.depth
+    lab = paving.labels
+    rows = np.flatnonzero(np.any([lab[n] == Label.BOUNDARY for n in ASPECT_NAMES], axis=0))
+    det = lab["det_positive"][rows]
+    det_sign = np.where(det == Label.INSIDE, 1, np.where(det == Label.OUTSIDE, -1, 0)).astype(np.int8)
+    return contract_labels(geometry, paving.lo[rows], paving.hi[rows], rows,
+                           {n: lab[n][rows] == Label.BOUNDARY for n in ASPECT_NAMES},
+                           w_undecided=lab["W"][rows] == Label.BOUNDARY, det_sign=det_sign, refine=refine, scale=scale)
+
+
+def pave_workspace(geometry: Geometry, depth: int, progress=None, split=None,
+                   contract: bool = False, refine: int = 0) -> Paving:
     """Pave W, the sign of det A and the two aspects in one pass.
 
     Labels: ``W``, ``det_positive`` (INSIDE: det A > 0, OUTSIDE: det A < 0),
@@ -100,6 +151,8 @@ def pave_workspace(geometry: Geometry, depth: int, progress=None, split=None) ->
     and the sign of det A is undecided (that is: while an aspect label is
     undecided).  det A is not evaluated on boxes certified outside W.  ``split``
     replaces that rule (labels -> bool mask of the boxes to subdivide).
+    ``contract``: also cut the BOUNDARY leaves of W, WA1 and WA2 into proved parts
+    (:func:`contract_paving`, ``refine`` rounds), stored in ``Paving.parts``.
     """
     def aspect_split(labels):
         w, d = labels["W"], labels["det_positive"]
@@ -116,4 +169,6 @@ def pave_workspace(geometry: Geometry, depth: int, progress=None, split=None) ->
         progress=progress,
     )
     p.labels["WA1"], p.labels["WA2"] = aspect_labels(p.labels["W"], p.labels["det_positive"])
+    if contract:
+        p.parts.update(contract_paving(geometry, p, refine))
     return p

@@ -36,7 +36,7 @@ import numpy as np
 
 from intervalkin.core.errors import InputError
 from intervalkin.core.interval import PI_HI
-from intervalkin.paving.labels import Label
+from intervalkin.paving.labels import Label, and_labels
 
 __all__ = ['workspace_paving_domain', 'box_bounds', 'split_boxes', 'Paving', 'pave_multi', 'pave']
 
@@ -79,6 +79,9 @@ class Paving:
     lo, hi : ndarray (n, 3) float64, the box bounds.
     labels : dict name -> ndarray (n,) uint8 of :class:`Label`.
     stats : list of per-level dicts (boxes evaluated, seconds, undecided volume).
+    parts : dict name -> off-grid parts of the BOUNDARY leaves of that label, proved
+        INSIDE / OUTSIDE by contractors (:class:`intervalkin.paving.contracted.ContractedParts`);
+        empty unless asked for.  The grid above does not depend on them.
     """
 
     domain: np.ndarray
@@ -89,6 +92,7 @@ class Paving:
     hi: np.ndarray
     labels: dict[str, np.ndarray] = field(default_factory=dict)
     stats: list[dict] = field(default_factory=list)
+    parts: dict = field(default_factory=dict)
 
     def __len__(self) -> int:
         return int(self.level.shape[0])
@@ -102,15 +106,26 @@ class Paving:
         """Volume of each box (n,), float (a measure, not a certified quantity)."""
         return np.prod(self.hi - self.lo, axis=1)
 
-    def volume_by_label(self, name: str) -> dict[str, float]:
-        """Total volume of INSIDE, BOUNDARY (undecided) and OUTSIDE boxes of one label."""
+    def volume_by_label(self, name: str, contracted: bool = False) -> dict[str, float]:
+        """Total volume of INSIDE, BOUNDARY (undecided) and OUTSIDE boxes of one label.
+
+        ``contracted``: the BOUNDARY leaves that were cut into parts (``parts[name]``)
+        count by their parts instead (KeyError when the label has no parts).
+        """
         v = self.volume()
         lab = self.labels[name]
-        return {
+        out = {
             "inside": float(v[lab == Label.INSIDE].sum()),
             "boundary": float(v[lab == Label.BOUNDARY].sum()),
             "outside": float(v[lab == Label.OUTSIDE].sum()),
         }
+        if contracted:
+            parts = self.parts[name]
+            cut = np.unique(parts.leaf)
+            out["boundary"] -= float(v[cut].sum())
+            for k, pv in parts.volume_by_label().items():
+                out[k] += pv
+        return out
 
     def count_by_label(self, name: str) -> dict[str, int]:
         lab = self.labels[name]
@@ -119,8 +134,12 @@ class Paving:
 
     def subset(self, mask: np.ndarray) -> "Paving":
         """The boxes selected by a boolean mask or index array (labels kept)."""
+        new_index = np.full(len(self), -1, dtype=np.int64)
+        kept = np.arange(len(self))[mask]
+        new_index[kept] = np.arange(kept.size)
         return Paving(self.domain, self.depth, self.level[mask], self.ijk[mask], self.lo[mask], self.hi[mask],
-                      {k: v[mask] for k, v in self.labels.items()}, list(self.stats))
+                      {k: v[mask] for k, v in self.labels.items()}, list(self.stats),
+                      {k: v.reindex(new_index) for k, v in self.parts.items()})
 
     @functools.cached_property
     def _sorted_keys(self) -> tuple[np.ndarray, np.ndarray]:
@@ -209,6 +228,12 @@ def pave_multi(
     A child inherits its parent's labels; a predicate is re-evaluated on the child
     only where the inherited label is BOUNDARY, and the new label is ANDed (as
     flags) with the inherited one, so labels only sharpen under subdivision.
+
+    A predicate that is a conjunction of m parts may say so: an integer attribute
+    ``conjuncts`` = m and a method ``conjunct_labels(boxes, todo (k, m) bool) -> (k, m)``
+    labels of the parts asked for.  The paver then keeps each box's part labels, asks
+    a child only for the parts its parent left BOUNDARY (a part proved on a box holds
+    on its sub-boxes), and the label is the AND of the parts (:func:`and_labels`).
     """
     items = list(predicates.items()) if isinstance(predicates, Mapping) else list(predicates)
     names = [n for n, _ in items]
@@ -227,6 +252,8 @@ def pave_multi(
     level = np.zeros(1, dtype=np.int64)
     ijk = np.zeros((1, 3), dtype=np.int64)
     inherited = {n: np.full(1, Label.BOUNDARY, dtype=np.uint8) for n in names}
+    parts_of = {n: int(getattr(fn, "conjuncts", 0) or 0) for n, fn in items}
+    inherited_parts = {n: np.full((1, m), Label.BOUNDARY, dtype=np.uint8) for n, m in parts_of.items() if m}
     leaves: list[tuple] = []
     stats: list[dict] = []
     for lev in range(depth + 1):
@@ -241,8 +268,16 @@ def pave_multi(
             if name in relevant:
                 todo &= relevant[name](labels)
             idx = np.flatnonzero(todo)
-            if idx.size:
+            if idx.size and parts_of[name]:
+                parts = inherited_parts[name]
+                sharp_parts = parts[idx] & np.asarray(fn.conjunct_labels(boxes[idx], parts[idx] == Label.BOUNDARY),
+                                                      dtype=np.uint8)
+                assert np.all(sharp_parts != Label.CONTRADICTION), f"{name}: contradictory part labels (unsound)"
+                parts[idx] = sharp_parts
+                new = functools.reduce(and_labels, [sharp_parts[:, j] for j in range(parts_of[name])])
+            elif idx.size:
                 new = np.asarray(fn(boxes[idx]), dtype=np.uint8)
+            if idx.size:
                 sharp = lab[idx] & new
                 assert np.all(sharp != Label.CONTRADICTION), f"{name}: contradictory labels (unsound evaluation)"
                 lab[idx] = sharp
@@ -267,6 +302,7 @@ def pave_multi(
             break
         level, ijk = split_boxes(level[cut], ijk[cut])
         inherited = {n: np.repeat(labels[n][cut], 8) for n in names}
+        inherited_parts = {n: np.repeat(v[cut], 8, axis=0) for n, v in inherited_parts.items()}
         del boxes, lo, hi
     out_labels = {n: np.concatenate([lf[4][n] for lf in leaves]) for n in names}
     return Paving(
