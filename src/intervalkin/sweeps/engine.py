@@ -22,6 +22,7 @@ import json
 import logging
 import os
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
@@ -126,9 +127,11 @@ class _Dask:
 
         if self.address is None:
             n = self.n or os.cpu_count() or 1
-            self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                        dashboard_address=":8787" if self.dashboard else None,
-                                        silence_logs=logging.ERROR)
+            with warnings.catch_warnings():  # "port 8787 is in use, using another": the link says which
+                warnings.simplefilter("ignore", UserWarning)
+                self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                            dashboard_address=":8787" if self.dashboard else None,
+                                            silence_logs=logging.ERROR)
             self.client = Client(self.cluster)
             return self
         try:
