@@ -67,6 +67,9 @@ def plot_sweep(rows: Sequence[Mapping[str, Any]], parameters: Sequence[str], fol
 
 
 def _draw_count(ax, xs, pts, col, colour, label) -> None:
+    from matplotlib.ticker import MaxNLocator
+
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     ax.plot(xs, [r[f"{col}_found"] for r in pts], "o-", color=colour, label=label, ms=4)
     ax.plot(xs, [r[f"{col}_lower"] for r in pts], "--", color=colour, lw=1)
 

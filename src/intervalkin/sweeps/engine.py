@@ -30,7 +30,7 @@ from typing import Any, Callable, Mapping
 from intervalkin.core.errors import InputError
 from intervalkin.core.files import write_json
 from intervalkin.sweeps.spec import Design, SweepSpec, load_sweep
-from intervalkin.sweeps.table import COUNT_NAMES, arrow_table, best_rows
+from intervalkin.sweeps.table import COUNT_NAMES, arrow_table, best_rows, columns
 from intervalkin.sweeps.task import count_from_json, run_design
 
 __all__ = ["SweepEvent", "SweepResult", "sweep", "CACHE_FORMAT"]
@@ -79,8 +79,9 @@ class SweepResult:
 
 
 def _row(spec: SweepSpec, d: Design, result: Mapping[str, Any] | None, cached: bool) -> dict[str, Any]:
-    """The table row of a design from its result (None: degenerate)."""
-    row: dict[str, Any] = {"design": d.index, "key": d.key or None}
+    """The table row of a design from its result (None: degenerate); every column is there, None when empty."""
+    row: dict[str, Any] = dict.fromkeys(columns(spec.parameters))
+    row.update(design=d.index, key=d.key or None)
     row.update({p: float(v) for p, v in zip(spec.parameters, d.values)})
     if result is None:
         row.update(status="degenerate", error=d.degenerate, cached=False)
@@ -91,7 +92,7 @@ def _row(spec: SweepSpec, d: Design, result: Mapping[str, Any] | None, cached: b
         c = count_from_json(result["counts"][name])
         row.update({f"{name}_found": c.found, f"{name}_lower": c.lower, f"{name}_upper": c.upper,
                     f"{name}_exact": c.exact})
-    row.update(result.get("volumes", {}))
+    row.update({k: v for k, v in result.get("volumes", {}).items() if k in row})
     return row
 
 
