@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import os
 import signal
+import time
 import tomllib
 from decimal import Decimal
 
@@ -52,7 +53,11 @@ def killed_run(cluster, tmp_path_factory):
     def kill_one(event):
         if event.kind != "design" or killed:
             return
-        busy = [w for w, keys in client.processing().items() if keys]
+        for _ in range(50):  # the scheduler hands the next designs out within milliseconds
+            busy = [w for w, keys in client.processing().items() if keys]
+            if busy:
+                break
+            time.sleep(0.1)
         assert busy, "no worker is analysing a design: the sweep cannot be interrupted mid-way"
         pid = client.run(os.getpid, workers=[busy[0]])[busy[0]]
         os.kill(pid, signal.SIGKILL)
