@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import csv
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import pytest
 
@@ -55,7 +60,7 @@ def test_the_folder_holds_table_plots_report_and_is_resumed(tmp_path, capsys):
     assert main(args) == 0
     first = capsys.readouterr()
     assert "3 designs: 2 computed, 0 cached, 0 failed, 1 degenerate" in first.out
-    assert "Dask: 1 workers, no dashboard; 2 designs to analyse" in first.err
+    assert "Dask: 1 worker, no dashboard; 2 designs to analyse" in first.err
     with open(out / "results.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     assert [r["platform.b1b2"] for r in rows] == ["17.04", "16.0", "40.0"]
@@ -78,3 +83,27 @@ def test_the_folder_holds_table_plots_report_and_is_resumed(tmp_path, capsys):
 
     assert main(args + ["--quiet", "--force"]) == 0  # --force starts afresh: the cache is recomputed
     assert json.loads((out / "summary.json").read_text())["computed"] == 2
+
+
+def test_an_interrupted_sweep_restarts_where_it_stopped(tmp_path, capsys):
+    (tmp_path / "s.toml").write_text('[analysis]\ndepth = 4\n[vary]\n"platform.scale" = [0.8, 0.9, 1.0, 1.1, 1.2]\n'
+                                     '"limits.rho_max" = [30, 34]\n')
+    out = tmp_path / "out"
+    args = ["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "--no-dashboard", "--quiet"]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    run = subprocess.Popen([sys.executable, "-m", "intervalkin.app.cli", *args], env=env,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and run.poll() is None and len(list((out / "designs").glob("*.json"))) < 2:
+        time.sleep(0.05)
+    run.send_signal(signal.SIGINT)
+    _, err = run.communicate(timeout=60)
+    done = len(list((out / "designs").glob("*.json")))
+    assert run.returncode == 130 and "interrupted" in err and 2 <= done < 10, (run.returncode, err, done)
+    assert not json.loads((out / MARKER).read_text())["complete"]
+    assert not list(out.rglob(".*.tmp"))  # nothing half-written
+
+    assert main(args) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert (summary["reused"], summary["computed"]) == (done, 10 - done)
+    assert len(list((out / "designs").glob("*.json"))) == 10

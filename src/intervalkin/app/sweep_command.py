@@ -88,7 +88,7 @@ class _Bar:
         if event.kind == "start":
             if not self.quiet:
                 where = f"dashboard {event.dashboard}" if event.dashboard else "no dashboard"
-                sys.stderr.write(f"Dask: {event.workers} workers, {where}; {event.total} designs to analyse\n")
+                sys.stderr.write(f"Dask: {_workers(event.workers)}, {where}; {event.total} designs to analyse\n")
                 sys.stderr.flush()
             self.bar = tqdm(total=event.total, unit="design", desc="designs", file=sys.stderr, dynamic_ncols=True,
                             disable=not shows_progress(sys.stderr, self.quiet))
@@ -96,6 +96,10 @@ class _Bar:
             self.bar.update(1)
             if event.done == event.total:
                 self.bar.close()
+
+
+def _workers(n: int) -> str:
+    return f"{n} worker" + ("" if n == 1 else "s")
 
 
 def _value(v) -> str:
@@ -124,7 +128,7 @@ def format_report(result: SweepResult, n_best: int = 5) -> str:
              + f": {len(ok)} analysed, {sum(r['status'] == 'failed' for r in rows)} failed, "
              f"{sum(r['status'] == 'degenerate' for r in rows)} degenerate; this run computed {len(result.computed)} "
              f"and reused {len(result.reused)} cached results in {result.seconds:.1f} s"
-             + (f" on {result.workers} Dask workers." if result.workers else "."), "",
+             + (f" on {_workers(result.workers)} of a Dask cluster." if result.workers else "."), "",
              f"## Best designs by `{by}` ({'largest' if order == 'max' else 'smallest'} first)", "",
              "Counts: found at this depth, with the certified lower bound (or exact when proved).", "",
              "| design | " + " | ".join(params) + f" | {by} | aspects | joint cells | basic regions | uniqueness domains |",
