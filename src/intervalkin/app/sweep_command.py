@@ -72,9 +72,11 @@ class SweepFolder(OutputFolder):
             yield self
 
 
-def _check_workers(workers) -> None:
+def _check_workers(workers, scheduler) -> None:
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise InputError(f"--workers: expected a positive integer, got {workers!r}")
+    if workers is not None and scheduler is not None:
+        raise InputError("--workers: sizes the LocalCluster; with --scheduler the running cluster has its own workers")
 
 
 class _Bar:
@@ -167,7 +169,7 @@ def run_sweep(path, out, scheduler: str | None = None, workers: int | None = Non
               quiet: bool = False, dashboard: bool = True) -> int:
     """``intervalkin sweep``: analyse every design of the sweep file on Dask, write the table, plots and report."""
     spec = load_sweep(path)
-    _check_workers(workers)
+    _check_workers(workers, scheduler)
     folder = SweepFolder.open(out, force, "sweep")
     root = folder.root
     t0 = time.perf_counter()

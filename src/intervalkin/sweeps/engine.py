@@ -107,7 +107,14 @@ def _read_cache(folder: Path | None, key: str) -> dict | None:
     if not isinstance(doc, dict) or doc.get("format") != CACHE_FORMAT or doc.get("key") != key:
         return None
     result = doc.get("result")
-    return result if isinstance(result, dict) and result.get("status") == "ok" else None
+    if not isinstance(result, dict) or result.get("status") != "ok":
+        return None
+    try:  # the counts must still be counts (their invariants are re-checked)
+        for name in COUNT_NAMES:
+            count_from_json(result["counts"][name])
+    except (KeyError, TypeError, ValueError):
+        return None
+    return result
 
 
 def _write_cache(folder: Path, spec: SweepSpec, d: Design, result: Mapping[str, Any]) -> None:
@@ -131,8 +138,11 @@ class _Dask:
             n = self.n or os.cpu_count() or 1
             # Dask's nannies start workers with MALLOC_TRIM_THRESHOLD_=65536, which makes glibc hand
             # memory back after every large numpy array: the analysis then runs about 4 times slower
-            # (measured: 3.3 s -> 18.7 s at depth 6, mostly system time), so that setting is left out.
+            # (measured: 3.3 s -> 18.7 s at depth 6, mostly system time), so that setting is left out,
+            # and taken out of this process's environment, where an earlier nanny may have put it
+            # (the workers inherit it, and so does a worker a nanny restarts later).
             no_trim = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+            os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
             with warnings.catch_warnings(), dask.config.set(no_trim):
                 warnings.simplefilter("ignore", UserWarning)  # "port 8787 is in use, using another": the link says which
                 self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
@@ -188,6 +198,8 @@ def sweep(spec: SweepSpec | str | Path, cache: str | Path | None = None, schedul
     spec = spec if isinstance(spec, SweepSpec) else load_sweep(spec)
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise InputError(f"workers: expected a positive integer, got {workers!r}")
+    if workers is not None and scheduler is not None:
+        raise InputError("workers: the number of workers is the running cluster's when a scheduler is given")
     folder = None if cache is None else Path(cache)
     results: dict[str, dict] = {}
     for d in spec.designs:
