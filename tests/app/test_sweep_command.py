@@ -26,6 +26,15 @@ depth = 3
 """
 
 
+@pytest.fixture(autouse=True)
+def restored_environment():
+    """Dask's nannies write their worker settings into this process's environment: put it back."""
+    saved = dict(os.environ)
+    yield
+    os.environ.clear()
+    os.environ.update(saved)
+
+
 def _err_line(capsys) -> str:
     err = capsys.readouterr().err
     assert err.count("\n") == 1, err
