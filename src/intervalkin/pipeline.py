@@ -344,7 +344,8 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     name = f"joint space paved directly (depth {dj}, {JOIN_LEVELS} join levels)"
     with contextlib.ExitStack() as side:
         future = None
-        if dj >= PARALLEL_JOINT_DEPTH and (os.cpu_count() or 1) > 1 and not multiprocessing.current_process().daemon:
+        daemonic = multiprocessing.current_process().daemon
+        if dj >= PARALLEL_JOINT_DEPTH and (os.cpu_count() or 1) > 1 and not daemonic:
             # the two pavings are independent: the joint one runs in a second process beside the regions
             # (not from a daemonic process, such as a Dask worker, which may not have children: in-process there)
             pool = side.enter_context(ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")))

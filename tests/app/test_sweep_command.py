@@ -45,7 +45,8 @@ def _err_line(capsys) -> str:
     ("[vary]\nbogus = [1]", [], "intervalkin: error: vary.'bogus': not a parameter of the base geometry"),
     ("[vary\n", [], "malformed TOML"),
     (SWEEP, ["--workers", "0"], "intervalkin: error: --workers: expected a positive integer, got 0"),
-    (SWEEP, ["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "intervalkin: error: --workers: sizes the LocalCluster"),
+    (SWEEP, ["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"],
+     "intervalkin: error: --workers: sizes the LocalCluster"),
 ])
 def test_bad_input_is_one_line_exit_2_and_no_folder(text, extra, expected, tmp_path, capsys):
     (tmp_path / "s.toml").write_text(text)

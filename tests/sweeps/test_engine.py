@@ -12,10 +12,10 @@ import json
 import os
 import signal
 import time
-import tomllib
 from decimal import Decimal
 
 import pytest
+import tomllib
 
 import intervalkin
 from intervalkin.sweeps.spec import parse_sweep
@@ -41,8 +41,10 @@ def _spec(text: str):
 def cluster():
     # as the sweep's own LocalCluster: without the malloc setting that makes the analysis 4 times slower
     no_trim = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
-    with dask.config.set(no_trim), distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                  silence_logs=40) as c, distributed.Client(c) as client:
+    with dask.config.set(no_trim):  # read when the nannies are made (a restarted worker gets the same)
+        c = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                     silence_logs=40)
+    with c, distributed.Client(c) as client:
         yield c, client
 
 

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import tomllib
 from decimal import Decimal
 
 import pytest
+import tomllib
 
 from intervalkin.core.geometry import default_geometry
 from intervalkin.sweeps.spec import Settings, SweepFileError, design_key, load_sweep, parse_sweep
@@ -76,7 +76,8 @@ def test_a_design_that_is_not_a_manipulator_is_degenerate_not_an_error():
     ('geometry = "missing.toml"\n[vary]\n"limits.rho_max" = [30]', "geometry"),
     ('colour = "red"\n[vary]\n"limits.rho_max" = [30]', "colour"),
     ('[vary]\n"limits.rho_max" = { start = 1, stop = 1000000, step = 1 }', "vary.'limits.rho_max'"),
-    ('[vary]\n"limits.rho_max" = { start = 1, stop = 1000, step = 1 }\n"limits.rho_min" = { start = 1, stop = 1000, step = 1 }',
+    ('[vary]\n"limits.rho_max" = { start = 1, stop = 1000, step = 1 }\n'
+     '"limits.rho_min" = { start = 1, stop = 1000, step = 1 }',
      "[vary]"),
 ])
 def test_a_bad_file_is_one_line_naming_its_field(text, field, tmp_path):

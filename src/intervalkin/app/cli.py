@@ -233,7 +233,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("sweep", help="analyse a family of designs (a sweep file) on Dask: table, plots, best designs")
     p.add_argument("file", metavar="FILE", help="sweep TOML file: base geometry, parameters to vary, analysis settings")
-    _out_options(p, "intervalkin-sweep", "output folder; an earlier sweep's folder is resumed (its cached designs are reused)")
+    _out_options(p, "intervalkin-sweep",
+                 "output folder; an earlier sweep's folder is resumed (its cached designs are reused)")
     p.add_argument("--scheduler", metavar="ADDRESS", default=None,
                    help="address of a running Dask scheduler (default: a LocalCluster on this machine)")
     p.add_argument("--workers", type=int, metavar="N", default=None,

@@ -133,7 +133,8 @@ def format_report(result: SweepResult, n_best: int = 5) -> str:
              + (f" on {_workers(result.workers)} of a Dask cluster." if result.workers else "."), "",
              f"## Best designs by `{by}` ({'largest' if order == 'max' else 'smallest'} first)", "",
              "Counts: found at this depth, with the certified lower bound (or exact when proved).", "",
-             "| design | " + " | ".join(params) + f" | {by} | aspects | joint cells | basic regions | uniqueness domains |",
+             "| design | " + " | ".join(params)
+             + f" | {by} | aspects | joint cells | basic regions | uniqueness domains |",
              "|---" * (len(params) + 6) + "|"]
     for r in result.best(n_best):
         lines.append(f"| {r['design']} | " + " | ".join(_value(r[p]) for p in params) + f" | {_value(r[by])} | "

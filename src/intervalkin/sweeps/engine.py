@@ -144,7 +144,8 @@ class _Dask:
             no_trim = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
             os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
             with warnings.catch_warnings(), dask.config.set(no_trim):
-                warnings.simplefilter("ignore", UserWarning)  # "port 8787 is in use, using another": the link says which
+                # "port 8787 is in use, using another": the link printed says which
+                warnings.simplefilter("ignore", UserWarning)
                 self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                             dashboard_address=":8787" if self.dashboard else None,
                                             silence_logs=logging.ERROR)

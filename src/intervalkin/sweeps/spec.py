@@ -39,12 +39,13 @@ import decimal
 import hashlib
 import itertools
 import json
-import tomllib
 from dataclasses import dataclass
 from decimal import Decimal
 from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
+
+import tomllib
 
 from intervalkin.core.errors import GeometryError, InputError
 from intervalkin.core.geometry import Geometry, parse_geometry
@@ -123,11 +124,13 @@ def _values(spec: Any, field: str) -> list[Decimal]:
     if isinstance(spec, dict):
         extra = set(spec) - {"start", "stop", "step"}
         if extra or set(spec) != {"start", "stop", "step"}:
-            what = f"unknown key {sorted(extra)[0]!r}" if extra else f"missing {sorted({'start', 'stop', 'step'} - set(spec))[0]!r}"
+            missing = sorted({"start", "stop", "step"} - set(spec))
+            what = f"unknown key {sorted(extra)[0]!r}" if extra else f"missing {missing[0]!r}"
             raise SweepFileError(f"{field}: a range is {{start, stop, step}}; {what}")
         start, stop, step = (_decimal(spec[k], f"{field}.{k}") for k in ("start", "stop", "step"))
         if step <= 0 or stop < start:
-            raise SweepFileError(f"{field}: expected start <= stop and step > 0, got start {start}, stop {stop}, step {step}")
+            raise SweepFileError(f"{field}: expected start <= stop and step > 0, "
+                                 f"got start {start}, stop {stop}, step {step}")
         n = int((stop - start) / step) + 1
         if n > MAX_DESIGNS:
             raise SweepFileError(f"{field}: the range has {n} values, more than {MAX_DESIGNS}")
@@ -260,7 +263,8 @@ def _best(doc: dict) -> tuple[str, str]:
         raise SweepFileError(f"best.{sorted(extra)[0]}: unknown key (allowed: by, order)")
     by, order = table.get("by", CRITERIA_DEFAULT), table.get("order", "max")
     if by not in NUMERIC_COLUMNS:
-        raise SweepFileError(f"best.by: expected a numeric column of the table ({', '.join(NUMERIC_COLUMNS)}), got {by!r}")
+        raise SweepFileError(f"best.by: expected a numeric column of the table "
+                             f"({', '.join(NUMERIC_COLUMNS)}), got {by!r}")
     if order not in ("max", "min"):
         raise SweepFileError(f"best.order: expected \"max\" or \"min\", got {order!r}")
     return by, order

@@ -17,8 +17,9 @@ from __future__ import annotations
 import decimal
 import threading
 import time
-import tomllib
 from typing import Any
+
+import tomllib
 
 from intervalkin.core.status import Count
 
