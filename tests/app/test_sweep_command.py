@@ -85,7 +85,9 @@ def test_the_folder_holds_table_plots_report_and_is_resumed(tmp_path, capsys):
     assert manifest["complete"] and manifest["command"] == "sweep"
     assert len([f for f in manifest["files"] if f.startswith("designs/")]) == 2
 
+    (out / "designs" / ".abc.json.1234.tmp").write_text("{")  # as a run killed mid-write would leave it
     assert main(args + ["--quiet"]) == 0  # the same folder again: resumed, nothing computed, no cluster
+    assert not list(out.rglob(".*.tmp"))
     again = capsys.readouterr()
     assert again.out == "" and again.err == ""
     summary = json.loads((out / "summary.json").read_text())

@@ -56,6 +56,8 @@ class SweepFolder(OutputFolder):
         if force or manifest is None or manifest.get("legacy") or manifest.get("command") != command:
             return super().open(out, force, command)  # type: ignore[return-value]
         root = writable_folder(root)
+        for tmp in root.rglob(".*.tmp"):  # a killed run's temporary files (never a finished one)
+            tmp.unlink()
         folder = cls(root, command, created=False)
         for rel in manifest["files"]:
             if Path(rel).is_absolute() or ".." in Path(rel).parts:
