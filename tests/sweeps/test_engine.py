@@ -8,6 +8,7 @@ check that every design still has exactly one result; the later sweeps reuse its
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import signal
@@ -130,6 +131,20 @@ def test_the_local_cluster_leaves_out_the_malloc_trim_setting_that_slows_the_ana
     from intervalkin.sweeps.engine import _Dask
 
     os.environ["MALLOC_TRIM_THRESHOLD_"] = "65536"  # as an earlier default LocalCluster leaves it in this process
-    with _Dask(None, 1, dashboard=False) as dask:
+    with _Dask(None, 1, dashboard=True) as dask:
         env = dask.client.run(lambda: (os.environ.get("MALLOC_TRIM_THRESHOLD_"), os.environ.get("OMP_NUM_THREADS")))
+        link = dask.link
     assert list(env.values()) == [(None, "1")]
+    assert link.startswith("http://") and link.endswith("/status")  # the dashboard the command prints
+
+
+def test_a_design_whose_analysis_fails_is_a_row_with_its_error_and_is_not_cached(cluster, tmp_path):
+    c, _ = cluster
+    spec = _spec('[analysis]\ndepth = 3\n[vary]\n"limits.rho_max" = [30, 32]')
+    broken = dataclasses.replace(spec.designs[0], geometry_toml="[base\n")  # the worker cannot even read it
+    spec = dataclasses.replace(spec, designs=(broken, spec.designs[1]))
+    result = intervalkin.sweep(spec, cache=tmp_path, scheduler=c.scheduler_address)
+    failed, ok = result.rows
+    assert failed["status"] == "failed" and failed["error"].startswith("TOMLDecodeError")
+    assert ok["status"] == "ok" and ok["aspects_found"] is not None
+    assert [p.name for p in tmp_path.iterdir()] == [f"{ok['key']}.json"]  # the failure is tried again next time
