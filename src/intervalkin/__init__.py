@@ -1,11 +1,12 @@
 """intervalkin: certified definition sets of the planar 3-RPR parallel manipulator.
 
-The library in four calls (each result says what is proved; see the README's "Library")::
+The library in five calls (each result says what is proved; see the README's "Library")::
 
     intervalkin.solve(rho, geometry=None)          -> DkpResult: every assembly mode, each proved unique
     intervalkin.analyse(geometry=None, depth=8)    -> Analysis: joint cells, basic regions, uniqueness domains
         Analysis.label(pose), Analysis.locate(rho), Analysis.counts()
     intervalkin.verify(path)                       -> VerifyReport: the independent checker's verdicts
+    intervalkin.sweep(file, cache=None)            -> SweepResult: one analysis per design, on Dask
 
 Layers, from the ground floor up (a layer imports only the layers below it; the
 import-linter contract in ``pyproject.toml`` enforces it):
@@ -19,6 +20,7 @@ space/       aspects, joint space, characteristic surfaces, basic regions, uniqu
 checker/     the independent verifier of certificates (standard library, python-flint and core only)
 certify/     claim files written from the results above
 pipeline     the whole analysis as one library call
+sweeps/      design sweeps: one analysis per design of a family, as Dask tasks, cached by content hash
 app/         the ``intervalkin`` command, output folders, report, export, figures, animation
 
 The public names below are loaded on first use, so ``import intervalkin`` and
@@ -54,6 +56,10 @@ _API = {
     "VerifyReport": "intervalkin.pipeline",
     "analyse": "intervalkin.pipeline",
     "verify": "intervalkin.pipeline",
+    "sweep": "intervalkin.sweeps.engine",
+    "SweepResult": "intervalkin.sweeps.engine",
+    "SweepSpec": "intervalkin.sweeps.spec",
+    "load_sweep": "intervalkin.sweeps.spec",
 }
 # ``intervalkin.solve`` is the solve/ layer itself, which is callable (see its docstring)
 _LAYERS = {"solve"}

@@ -68,7 +68,8 @@ DEFAULT_DEPTH = 8
 #: Deepest workspace depth of the chain (its singular layer is paved one level deeper).
 MAX_CHAIN_DEPTH = 9
 #: From this joint depth on, the direct joint paving runs in a second process, beside the
-#: regions paving (they are independent; the default run has two cores to use).
+#: regions paving (they are independent; the default run has two cores to use), unless the
+#: caller is a daemonic process (a Dask worker of a sweep), which may not start children.
 PARALLEL_JOINT_DEPTH = 6
 
 
@@ -343,8 +344,10 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     name = f"joint space paved directly (depth {dj}, {JOIN_LEVELS} join levels)"
     with contextlib.ExitStack() as side:
         future = None
-        if dj >= PARALLEL_JOINT_DEPTH and (os.cpu_count() or 1) > 1:
+        daemonic = multiprocessing.current_process().daemon
+        if dj >= PARALLEL_JOINT_DEPTH and (os.cpu_count() or 1) > 1 and not daemonic:
             # the two pavings are independent: the joint one runs in a second process beside the regions
+            # (not from a daemonic process, such as a Dask worker, which may not have children: in-process there)
             pool = side.enter_context(ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")))
             future = pool.submit(pave_joint_cells, geometry, dj, JOIN_LEVELS)
         else:

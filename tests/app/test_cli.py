@@ -19,7 +19,7 @@ from intervalkin.core.geometry import default_geometry
 from intervalkin.solve.dkp import parse_joint_vector, solve
 
 TABLE1 = ["14.98", "15.38", "12.0"]
-SUBCOMMANDS = ("dkp", "table1", "pave", "joint", "analyze", "paper", "label", "locate", "trajectory", "verify")
+SUBCOMMANDS = ("dkp", "table1", "pave", "joint", "analyze", "paper", "label", "locate", "trajectory", "verify", "sweep")
 
 
 def _run(argv) -> int:
@@ -263,6 +263,8 @@ def test_label_of_a_pose_beyond_float_range_is_bad_input(tmp_path, capsys):
     (["locate", "15"], "required: R2, R3"),
     (["trajectory", "--rho", "1", "--from", "1", "--to", "2"], "--rho"),
     (["table1", "--bogus"], "unrecognized"),
+    (["sweep"], "required: FILE"),
+    (["sweep", "s.toml", "--workers", "two"], "--workers"),
 ])
 def test_usage_errors_show_the_usage_and_one_error_line(argv, fragment, capsys):
     """argparse's own errors: the command's usage on one line, one error line naming what is wrong, status 2.

@@ -27,7 +27,7 @@ from intervalkin.pipeline import check_chain_depth
 from intervalkin.solve.dkp import parse_joint_vector, solve
 
 TABLE1 = ["14.98", "15.38", "12.0"]
-COMMANDS = ("dkp", "table1", "pave", "joint", "analyze", "paper", "label", "locate", "trajectory", "verify")
+COMMANDS = ("dkp", "table1", "pave", "joint", "analyze", "paper", "label", "locate", "trajectory", "verify", "sweep")
 #: A cheap valid command line of each command that writes a folder (the folder flag added by the tests).
 WRITERS = {
     "pave": ["pave", "--depth", "3"],
@@ -115,7 +115,7 @@ def test_help_prints_the_usage_and_every_depth_range(command, capsys):
         assert re.search(rf"--depth N .{{0,120}}?\b{lo}\.\.{hi}\b", help_text), help_text
 
 
-@pytest.mark.parametrize("command", ["dkp", "label", "locate", "trajectory", "verify"])
+@pytest.mark.parametrize("command", ["dkp", "label", "locate", "trajectory", "verify", "sweep"])
 def test_no_argument_is_a_usage_error(command, refused):
     refused([command], "required", usage=True)
 

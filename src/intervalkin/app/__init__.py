@@ -22,4 +22,6 @@ figures_workspace, figures_joint   the paper's workspace and joint-space figures
 scenes     3-D scenes shared by the PNGs and the HTML
 plotting, palette, units   matplotlib set-up, one colour per id, axis names and the phi unit
 animation  the trajectory figures and animation
+sweep_command   ``intervalkin sweep``: a design sweep (intervalkin.sweeps) into a resumable folder, its report
+sweep_plots     the sweep's counts and volumes against the swept parameters
 """

@@ -29,6 +29,7 @@ from typing import Callable, NoReturn, Sequence
 from intervalkin.app.commands import run_analyze, run_joint, run_pave, run_trajectory
 from intervalkin.app.label import run_label, run_locate
 from intervalkin.app.options import CHAIN_DEPTHS, JOINT_DEPTHS, PAVE_DEPTHS, depth_help, geometry_from_option
+from intervalkin.app.sweep_command import run_sweep
 from intervalkin.app.table1 import format_table1, table1_comparison
 from intervalkin.app.text import format_dkp_table
 from intervalkin.core.errors import IntervalkinError
@@ -112,6 +113,11 @@ def _cmd_trajectory(args: argparse.Namespace) -> int:
                           as_json=args.json, quiet=args.quiet, force=args.force)
 
 
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    return run_sweep(args.file, args.out, scheduler=args.scheduler, workers=args.workers, force=args.force,
+                     quiet=args.quiet, dashboard=not args.no_dashboard)
+
+
 def _cmd_verify(args: argparse.Namespace) -> int:
     results = verify(args.dir).results  # DIR: the certificate folder, or an output folder holding one
     for r in results:
@@ -137,6 +143,7 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "pave": _cmd_pave,
     "trajectory": _cmd_trajectory,
     "verify": _cmd_verify,
+    "sweep": _cmd_sweep,
 }
 
 
@@ -223,6 +230,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--depth", type=int, default=QUESTION_DEPTH, metavar="N", help=chain_depth)
     _out_options(p, None, "write trajectory.json and the figures into this folder")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("sweep", help="analyse a family of designs (a sweep file) on Dask: table, plots, best designs")
+    p.add_argument("file", metavar="FILE", help="sweep TOML file: base geometry, parameters to vary, analysis settings")
+    _out_options(p, "intervalkin-sweep",
+                 "output folder; an earlier sweep's folder is resumed (its cached designs are reused)")
+    p.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="address of a running Dask scheduler (default: a LocalCluster on this machine)")
+    p.add_argument("--workers", type=int, metavar="N", default=None,
+                   help="worker processes of the LocalCluster (default: one per core)")
+    p.add_argument("--no-dashboard", action="store_true", help="do not serve the Dask dashboard")
 
     p = sub.add_parser("verify", help="re-check a certificate folder with the independent checker (arb only)")
     p.add_argument("dir", metavar="DIR",
