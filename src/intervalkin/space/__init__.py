@@ -5,6 +5,7 @@ singular_surface        the singular layer of the workspace and the image g(S)
 joint_space             joint cells off an outer enclosure of g(S) (voxel grid)
 joint_paving            joint space paved directly: boxes proved off g(S), adaptive (solve.joint_box)
 joint_cells             the cells of that paving, their certified counts, joins, regions from cells
+joint_pieces            the two pieces of each fold box (solve.fold_model) and the points that join them to cells
 characteristic_surface  aspect boxes certified off S_c
 pieces, sheets, voxel_paths   pieces of certified boxes and the sheet above a cell each lies on
 basic_region            basic regions and basic components (Theorem 1, Proposition 1)
