@@ -230,18 +230,31 @@ def _run(client, spec: SweepSpec, todo: Mapping[str, Design], results: dict[str,
     settings = spec.settings.to_json()
     futures = {client.submit(run_design, d.geometry_toml, settings, key=f"intervalkin-design-{k}"): k
                for k, d in todo.items()}
+    retried: set[str] = set()
     try:
-        for done, fut in enumerate(as_completed(futures), start=1):
+        pending = as_completed(futures)
+        done = 0
+        for fut in pending:
             key = futures[fut]
             try:
                 result = fut.result()
             except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker: the design failed, the others go on
+                if key not in retried:
+                    # run_design returns its own failures: an exception here comes from the cluster (a lost
+                    # worker, a broken connection), so the design is submitted once more before it is failed
+                    retried.add(key)
+                    again = client.submit(run_design, todo[key].geometry_toml, settings,
+                                          key=f"intervalkin-design-{key}-retry")
+                    futures[again] = key
+                    pending.add(again)
+                    continue
                 result = {"status": "failed", "error": f"{type(exc).__name__}: {exc}".splitlines()[0]}
+            done += 1
             results[key] = result
             if result["status"] == "ok" and folder is not None:
                 _write_cache(folder, spec, todo[key], result)
             if progress is not None:
-                progress(SweepEvent("design", done, len(futures), row=_row(spec, todo[key], result, False)))
+                progress(SweepEvent("design", done, len(todo), row=_row(spec, todo[key], result, False)))
     finally:
         client.cancel(list(futures))
 
