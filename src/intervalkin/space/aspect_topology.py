@@ -1,0 +1,264 @@
+"""The number of aspects, bounded from above: each sign's part of W minus {det A = 0} proved connected.
+
+For a sign s let S_s = {X in W : s det A(X) > 0} (WA1 for s = +1, WA2 for s = -1).
+The aspects are the connected components of S_+ and of S_-, so
+
+    number of aspects = c(S_+) + c(S_-),   c = number of connected components,
+
+and the count is exact (= 2) when both sets are proved nonempty and connected.
+:func:`prove_aspects` builds, for each sign, a COVER of the paving domain by octree
+boxes (integer coordinates, as in :mod:`intervalkin.paving.tree`), each box one of
+
+* OUT: certified free of S_s;
+* SINK: certified inside S_s; the sinks form ONE face-connected set of boxes;
+* RET(e): the retraction condition of :mod:`intervalkin.space.aspect_retraction`
+  holds along e, and every box across an exit face of e is OUT, a SINK, or a RET
+  box of lower rank (the ranks make the chains acyclic);
+* LEFT: none of these could be proved (reported: location and volume).
+
+Lemma (proofs/lemma-aspect-retraction.md): with no LEFT box, every point of S_s is
+joined inside S_s to the sinks, whose union is connected: S_s is connected.  An IN
+box that is not a sink needs no condition of its own (every direction retracts it),
+so small fragments of IN boxes are joined to the sinks through their exit faces:
+the joins of fragments and the absence of hidden pieces come from one argument.
+
+How the cover is built: boxes are split top-down while neither OUT, IN nor
+retractable (up to ``start_depth``); then ranks are computed by a fixed point over
+the face adjacency (vectorized: one pass over the face pairs per rank); boxes left
+unresolved are split and re-classified, up to ``max_depth``.  Only the last step is
+iterated, so the cover stays small (a few ten thousand boxes where the paving has
+millions): the independent checker re-proves every box of it in arb.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from intervalkin.core.geometry import Geometry
+from intervalkin.paving.adjacency import component_labels, shares_face
+from intervalkin.paving.tree import box_bounds, split_boxes, workspace_paving_domain
+from intervalkin.space.aspect_retraction import DIRECTIONS, classify_boxes, exit_faces, shared_direction
+
+__all__ = ["OUT", "SINK", "RET", "LEFT", "AspectCover", "AspectTopology", "face_pairs", "resolve_cover",
+           "cover_aspect", "prove_aspects"]
+
+#: Kinds of the boxes of a cover.
+OUT, SINK, RET, LEFT = 0, 1, 2, 3
+#: Refinement rounds of the unresolved boxes (each one splits them once).
+MAX_ROUNDS = 12
+
+
+@dataclass(frozen=True, eq=False)
+class AspectCover:
+    """A cover of the paving domain for one sign of det A (module docstring).
+
+    ``level`` (n,), ``ijk`` (n, 3): the boxes; ``kind`` (n,): OUT, SINK, RET or LEFT;
+    ``direction`` (n, 3) int: e = (a, b, c / PHI_DIVISOR) of RET boxes (0 elsewhere);
+    ``rank`` (n,): 0 for OUT and SINK, the step at which a RET box was resolved, -1 for LEFT.
+    ``fragments``: face-connected components of IN boxes (before the joins by retraction).
+    ``connected``: no LEFT box and at least one sink: S_s is proved nonempty and connected.
+    ``empty``: every box is OUT: S_s is proved empty.
+    """
+
+    sign: int
+    domain: np.ndarray
+    level: np.ndarray
+    ijk: np.ndarray
+    kind: np.ndarray
+    direction: np.ndarray
+    rank: np.ndarray
+    fragments: int
+    seconds: float
+
+    @property
+    def connected(self) -> bool:
+        return not np.any(self.kind == LEFT) and bool(np.any(self.kind == SINK))
+
+    @property
+    def empty(self) -> bool:
+        return bool(np.all(self.kind == OUT))
+
+    def boxes(self, mask: np.ndarray | None = None) -> np.ndarray:
+        """Float boxes (m, 3, 2) of the selected cover boxes (all when ``mask`` is None)."""
+        sel = slice(None) if mask is None else mask
+        lo, hi = box_bounds(self.domain, self.level[sel], self.ijk[sel])
+        return np.stack([lo, hi], axis=-1)
+
+    def leftovers(self) -> list[dict]:
+        """The LEFT boxes: where the proof did not close (box bounds and volume)."""
+        b = self.boxes(self.kind == LEFT)
+        return [{"box": bb.tolist(), "volume": float(np.prod(bb[:, 1] - bb[:, 0]))} for bb in b]
+
+    def to_json(self) -> dict:
+        kinds = {name: int(np.count_nonzero(self.kind == v)) for name, v in
+                 (("out", OUT), ("sink", SINK), ("retract", RET), ("left", LEFT))}
+        return {"sign": self.sign, "boxes": int(len(self.level)), "kinds": kinds, "inside_fragments": self.fragments,
+                "connected": self.connected, "empty": self.empty, "deepest_level": int(self.level.max()),
+                "longest_chain": int(self.rank.max()), "seconds": round(self.seconds, 3),
+                "leftovers": self.leftovers()[:20]}
+
+
+@dataclass(frozen=True, eq=False)
+class AspectTopology:
+    """Both covers and the upper bound they prove on the number of aspects (None: not proved)."""
+
+    covers: tuple[AspectCover, ...]
+
+    @property
+    def upper(self) -> int | None:
+        if not all(c.connected or c.empty for c in self.covers):
+            return None
+        return sum(1 for c in self.covers if c.connected)
+
+    @property
+    def seconds(self) -> float:
+        return sum(c.seconds for c in self.covers)
+
+
+def face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Directed face adjacency of a tiling: (pairs (3, m): box, neighbour, face), on_border (n, 6), edges.
+
+    Row (a, b, f): b lies across face f of a (face 2k: -axis-k side, 2k + 1: + side; phi wraps).
+    ``on_border[a, f]``: face f of a lies on the x or y border of the domain (no neighbour there).
+    ``edges`` is :func:`~intervalkin.paving.adjacency.shares_face` of the boxes.
+    """
+    level = np.asarray(level, dtype=np.int64)
+    edges = shares_face(level, ijk, depth)
+    shift = (depth - level)[:, None]
+    lo, hi = ijk << shift, (ijk + 1) << shift
+    nfine = np.int64(1) << depth
+    a, b = edges
+    rows = []
+    for ax in range(3):
+        others = [o for o in range(3) if o != ax]
+        overlap = np.all(np.minimum(hi[a][:, others], hi[b][:, others]) > np.maximum(lo[a][:, others],
+                                                                                     lo[b][:, others]), axis=1)
+        wrap = nfine if ax == 2 else np.int64(1) << 62
+        for p, q in ((a, b), (b, a)):
+            m = overlap & ((hi[p, ax] % wrap) == (lo[q, ax] % wrap))  # q across the + face of p
+            rows.append(np.stack([p[m], q[m], np.full(int(m.sum()), 2 * ax + 1)]))
+            rows.append(np.stack([q[m], p[m], np.full(int(m.sum()), 2 * ax)]))
+    pairs = np.concatenate(rows, axis=1)
+    border = np.zeros((len(level), 6), dtype=bool)
+    for ax in range(2):
+        border[:, 2 * ax] = lo[:, ax] == 0
+        border[:, 2 * ax + 1] = hi[:, ax] == nfine
+    return pairs, border, edges
+
+
+def resolve_cover(level, ijk, depth, out, inside, ok, custom_faces, volume):
+    """Sinks, ranks and chosen candidates of the boxes of one cover (numpy fixed point).
+
+    The sinks are the face-connected component of IN boxes of largest volume; other IN boxes
+    take any fixed direction.  Returns (kind, rank, choice, fragments, edges); ``choice`` indexes
+    the candidate directions (-1: none), LEFT boxes are those no rank reached, ``edges`` the face
+    adjacency.
+    """
+    n = len(level)
+    pairs, border, edges = face_pairs(level, ijk, depth)
+    comp = component_labels(n, edges, inside)
+    fragments = int(comp.max()) + 1 if np.any(inside) else 0
+    sink = np.zeros(n, dtype=bool)
+    if fragments:
+        vol = np.bincount(comp[inside], weights=volume[inside], minlength=fragments)
+        sink = comp == int(np.argmax(vol))
+    ok = ok.copy()
+    ok[inside & ~sink, :len(DIRECTIONS)] = True  # the fixed directions only (a per-box one may be 0)
+    fixed_faces = exit_faces(DIRECTIONS).astype(np.uint8)  # (m, 6)
+    resolved = out | sink
+    rank = np.where(resolved, 0, -1)
+    choice = np.full(n, -1, dtype=np.int64)
+    step = 0
+    while True:
+        step += 1
+        bad = border.copy()
+        nb = ~resolved[pairs[1]]
+        bad[pairs[0][nb], pairs[2][nb]] = True
+        blocked = np.concatenate([(bad.astype(np.uint8) @ fixed_faces.T) > 0,
+                                  np.any(custom_faces & bad[:, None, :], axis=-1)], axis=1)
+        good = ok & ~blocked & ~resolved[:, None]
+        new = np.any(good, axis=1)
+        if not np.any(new):
+            break
+        choice[new] = np.argmax(good[new], axis=1)
+        rank[new] = step
+        resolved |= new
+    kind = np.full(n, LEFT, dtype=np.uint8)
+    kind[out] = OUT
+    kind[sink] = SINK
+    kind[(rank > 0)] = RET
+    return kind, rank, choice, fragments, edges
+
+
+def _classified(geometry, domain, level, ijk, sign):
+    """Labels of boxes given by integer coordinates, with room for a third per-box direction (shared)."""
+    lo, hi = box_bounds(domain, level, ijk)
+    c = classify_boxes(geometry, np.stack([lo, hi], axis=-1), sign)
+    n = len(level)
+    ok = np.concatenate([c.ok, np.zeros((n, 1), dtype=bool)], axis=1)
+    custom = np.concatenate([c.custom, np.zeros((n, 1, 3), dtype=np.int64)], axis=1)
+    return [c.out, c.inside, ok, custom, np.prod(hi - lo, axis=1)]
+
+
+def _share_directions(geometry, domain, level, ijk, kind, edges, sign, ok, custom) -> None:
+    """Give each face-connected cluster of LEFT boxes one shared direction where it is certified (in place)."""
+    left = kind == LEFT
+    comp = component_labels(len(level), edges, left)
+    for c in range(int(comp.max()) + 1 if np.any(left) else 0):
+        rows = np.flatnonzero(comp == c)
+        lo, hi = box_bounds(domain, level[rows], ijk[rows])
+        e, good = shared_direction(geometry, np.stack([lo, hi], axis=-1), sign)
+        custom[rows[good], 2] = e
+        ok[rows[good], -1] = True
+
+
+def cover_aspect(geometry: Geometry, sign: int, start_depth: int = 9, max_depth: int = 12) -> AspectCover:
+    """The cover of S_sign (module docstring): split top-down to ``start_depth``, then refine the unresolved.
+
+    Each round resolves the cover; clusters of unresolved boxes are given a shared direction and
+    the cover is resolved again; what is still unresolved is split (up to ``max_depth``).
+    """
+    t0 = time.perf_counter()
+    domain = workspace_paving_domain(geometry)
+    level = np.zeros(1, dtype=np.int64)
+    ijk = np.zeros((1, 3), dtype=np.int64)
+    parts = []
+    for lev in range(start_depth + 1):  # top-down: split what is neither OUT, IN nor retractable
+        lab = _classified(geometry, domain, level, ijk, sign)
+        out, inside, ok = lab[:3]
+        cut = ~out & ~inside & ~np.any(ok, axis=1) & (lev < start_depth)
+        parts.append([level[~cut], ijk[~cut]] + [a[~cut] for a in lab])
+        if not np.any(cut):
+            break
+        level, ijk = split_boxes(level[cut], ijk[cut])
+    level, ijk, out, inside, ok, custom, vol = (np.concatenate(p) for p in zip(*parts))
+    for _ in range(MAX_ROUNDS):
+        depth = max(int(level.max()), 1)
+        kind, rank, choice, fragments, edges = resolve_cover(level, ijk, depth, out, inside, ok, exit_faces(custom), vol)
+        if np.any(kind == LEFT):
+            _share_directions(geometry, domain, level, ijk, kind, edges, sign, ok, custom)
+            kind, rank, choice, fragments, edges = resolve_cover(level, ijk, depth, out, inside, ok,
+                                                                 exit_faces(custom), vol)
+        cut = (kind == LEFT) & (level < max_depth)
+        if not np.any(cut):
+            break
+        cl, cijk = split_boxes(level[cut], ijk[cut])
+        lab = _classified(geometry, domain, cl, cijk, sign)
+        keep = ~cut
+        level, ijk = np.concatenate([level[keep], cl]), np.concatenate([ijk[keep], cijk])
+        out, inside, ok, custom, vol = (np.concatenate([a[keep], b]) for a, b in zip((out, inside, ok, custom, vol), lab))
+    direction = np.zeros((len(level), 3), dtype=np.int64)
+    rows = np.flatnonzero(kind == RET)
+    j = choice[rows]
+    m = len(DIRECTIONS)
+    direction[rows] = np.where((j < m)[:, None], DIRECTIONS[np.minimum(j, m - 1)], custom[rows, np.clip(j - m, 0, 2)])
+    return AspectCover(sign, domain, level.astype(np.int64), ijk, kind, direction, rank, fragments,
+                       time.perf_counter() - t0)
+
+
+def prove_aspects(geometry: Geometry, start_depth: int = 9, max_depth: int = 12) -> AspectTopology:
+    """Covers of WA1 (det A > 0) and WA2 (det A < 0); :attr:`AspectTopology.upper` is the proved bound."""
+    return AspectTopology(tuple(cover_aspect(geometry, s, start_depth, max_depth) for s in (1, -1)))
