@@ -53,6 +53,12 @@ __all__ = ["PHI_DIVISOR", "GRID", "DIRECTIONS", "BoxRetraction", "exit_faces", "
 #: e = (a, b, c / PHI_DIVISOR): a turn of the platform moves its points about 20 times further than
 #: a unit shift, so the phi component is scaled down to balance the gradients.
 PHI_DIVISOR = 16
+#: On coarse boxes every decision (a bound's sign) is taken only when it holds with a margin of MARGIN
+#: times the enclosure's width: a box decided narrowly by the library's tight forms is split instead, so that the
+#: checker's plainer arb forms decide its few children at once (soundness does not depend on it).
+MARGIN = 0.05
+#: Boxes of this level and deeper are decided without a margin (the checker's forms are tight enough there).
+MARGIN_LEVEL = 8
 #: Largest |component| of a direction built per box (its components are rounded to this grid).
 GRID = 16
 
@@ -137,10 +143,12 @@ def _constraints(geometry: Geometry, boxes: np.ndarray, sign: int):
     k = constants(geometry)
     r = rho_sq_interval(geometry, boxes)
     sd = det_a_interval(geometry, boxes) * float(sign)
-    low_open = ~(r.lo >= k.rho_min_sq_iv.hi)   # rho_i^2 >= rho_min_i^2 not certified
-    high_open = ~(r.hi <= k.rho_max_sq_iv.lo)  # rho_i^2 <= rho_max_i^2 not certified
-    out = np.any((r.hi < k.rho_min_sq_iv.lo) | (r.lo > k.rho_max_sq_iv.hi), axis=1) | (sd.hi < 0)
-    opened = np.concatenate([low_open, high_open, ~(sd.lo > 0)[:, None]], axis=1)
+    mu = margins(boxes)
+    rm, dm = mu[:, None] * (r.hi - r.lo), mu * (sd.hi - sd.lo)  # the margins asked of every decision
+    low_open = ~(r.lo - rm >= k.rho_min_sq_iv.hi)   # rho_i^2 >= rho_min_i^2 not certified (with the margin)
+    high_open = ~(r.hi + rm <= k.rho_max_sq_iv.lo)  # rho_i^2 <= rho_max_i^2 likewise
+    out = np.any((r.hi + rm < k.rho_min_sq_iv.lo) | (r.lo - rm > k.rho_max_sq_iv.hi), axis=1) | (sd.hi + dm < 0)
+    opened = np.concatenate([low_open, high_open, ~(sd.lo - dm > 0)[:, None]], axis=1)
     inside = ~out & ~np.any(opened, axis=1)
 
     def gradients(idx: np.ndarray) -> list[Interval]:
@@ -149,18 +157,24 @@ def _constraints(geometry: Geometry, boxes: np.ndarray, sign: int):
         rows = [Interval(jac.lo[:, i, :], jac.hi[:, i, :]) for i in range(3)]
         return rows + [-g for g in rows] + [det_a_gradient_interval(geometry, b) * float(sign)]
 
-    return out, inside, opened, gradients
+    return out, inside, opened, gradients, mu
 
 
 def _midpoints(grads: list[Interval]) -> np.ndarray:
     return np.nan_to_num(np.stack([0.5 * (g.lo + g.hi) for g in grads], axis=1))
 
 
-def _certified(grads: list[Interval], opened: np.ndarray, dirs: np.ndarray) -> np.ndarray:
+def margins(boxes: np.ndarray) -> np.ndarray:
+    """The margin asked of the decisions on each box: MARGIN above level MARGIN_LEVEL (phi width), else 0."""
+    return np.where(boxes[:, 2, 1] - boxes[:, 2, 0] > 1.5 * 2 * np.pi / 2.0**MARGIN_LEVEL, MARGIN, 0.0)
+
+
+def _certified(grads: list[Interval], opened: np.ndarray, dirs: np.ndarray, mu: np.ndarray) -> np.ndarray:
     """(n, m): every open constraint has D_e f >= 0 certified on the box, for dirs (m, 3) or (n, m, 3)."""
     good = np.ones((opened.shape[0],) + dirs.shape[-2:-1], dtype=bool)
     for j, g in enumerate(grads):
-        good &= ~opened[:, j, None] | (_slopes(g, dirs).lo >= 0)
+        sl = _slopes(g, dirs)
+        good &= ~opened[:, j, None] | (sl.lo - mu[:, None] * (sl.hi - sl.lo) >= 0)
     return good & np.any(dirs != 0, axis=-1)
 
 
@@ -172,7 +186,7 @@ def classify_boxes(geometry: Geometry, boxes: np.ndarray, sign: int) -> BoxRetra
     whole box.  Cost: the enclosures of rho_i^2 and det A on every box, and the Jacobian and
     grad det A on the boxes that are neither OUT nor IN.
     """
-    out, inside, opened, gradients = _constraints(geometry, boxes, sign)
+    out, inside, opened, gradients, mu = _constraints(geometry, boxes, sign)
     n, nd = len(boxes), len(DIRECTIONS)
     ok = np.zeros((n, nd + 2), dtype=bool)
     custom = np.zeros((n, 2, 3), dtype=np.int64)
@@ -181,8 +195,8 @@ def classify_boxes(geometry: Geometry, boxes: np.ndarray, sign: int) -> BoxRetra
         return BoxRetraction(out, inside, ok, custom)
     grads = gradients(idx)
     own = _custom_directions(_midpoints(grads), opened[idx])
-    ok[idx, :nd] = _certified(grads, opened[idx], DIRECTIONS)
-    ok[idx, nd:] = _certified(grads, opened[idx], own)
+    ok[idx, :nd] = _certified(grads, opened[idx], DIRECTIONS, mu[idx])
+    ok[idx, nd:] = _certified(grads, opened[idx], own, mu[idx])
     custom[idx] = own
     return BoxRetraction(out, inside, ok, custom)
 
@@ -196,7 +210,7 @@ def shared_direction(geometry: Geometry, boxes: np.ndarray, sign: int) -> tuple[
     least-norm solution of g_j . e = 1 over the open constraints, g_j their normalised midpoint
     gradients averaged over the cluster.
     """
-    out, inside, opened, gradients = _constraints(geometry, boxes, sign)
+    out, inside, opened, gradients, mu = _constraints(geometry, boxes, sign)
     idx = np.flatnonzero(~out & ~inside)
     ok = np.zeros(len(boxes), dtype=bool)
     if idx.size == 0:
@@ -209,5 +223,5 @@ def shared_direction(geometry: Geometry, boxes: np.ndarray, sign: int) -> tuple[
     mean = g.sum(axis=0)[used]
     mean /= np.maximum(np.linalg.norm(mean, axis=-1, keepdims=True), 1e-300)
     e = _to_grid(np.linalg.pinv(mean) @ np.ones(int(used.sum())))
-    ok[idx] = _certified(grads, opened[idx], e[None, :])[:, 0]
+    ok[idx] = _certified(grads, opened[idx], e[None, :], mu[idx])[:, 0]
     return e, ok
