@@ -243,37 +243,9 @@ def _sinks_connected(keys: set, sinks: list, deepest: int) -> bool:
     return len({root(k) for k in sinks}) == 1
 
 
-def check_aspect_connected(model: ArbModel, claim: dict, prec: int) -> tuple[str, dict]:
-    """Re-prove one ``aspect_connected`` claim (module docstring); facts: sign, connected, empty."""
-    aspect, sign = read_aspect(claim)
-    domain = read_hex_box(get(claim, "domain"), "domain")
-    dirs, rows = _read_rows(claim)
-    deepest = max(k[0] for k, _ in rows)
-    keys = {k for k, _ in rows}
-    if len(keys) != len(rows):
-        raise Refused("boxes: a box is listed twice")
-    _check_domain(model, domain, deepest)
-    _check_tiling(keys, deepest)
-    evec = [(arb(a), arb(b), arb(c) / div) for a, b, c, div in dirs]
-    resolved: set = set()
-    sinks = []
-    for key, code in rows:  # OUT and SINK first: they are resolved from the start
-        if code == _OUT:
-            if not holds_on_box(_box(domain, key), lambda s: _beyond_or_opposite(model, s, sign)):
-                raise Refused(f"box {list(key)}: not proved free of {aspect}")
-        elif code == _SINK:
-            if not holds_on_box(_box(domain, key), lambda s: _in_aspect(model, s, sign)):
-                raise Refused(f"box {list(key)}: not proved inside {aspect}")
-            sinks.append(key)
-        else:
-            continue
-        resolved.add(key)
-    if len(resolved) == len(rows) and not sinks:
-        return f"every box of the cover is proved free of {aspect}: {aspect} is empty", \
-            {"aspect_sign": sign, "connected": False, "empty": True}
-    if not sinks or not _sinks_connected(keys, sinks, deepest):
-        raise Refused("the sink boxes are not one face-connected set")
-    n_ret = 0
+def _check_order(keys: set, rows: list, dirs: list, deepest: int) -> None:
+    """Every box across an exit face of a retracting box is OUT, a sink or an earlier retracting box."""
+    resolved = {key for key, code in rows if code < 0}
     for key, code in rows:
         if code < 0:
             continue
@@ -287,10 +259,45 @@ def check_aspect_connected(model: ArbModel, claim: dict, prec: int) -> tuple[str
             if any(nb not in resolved for nb in nbs):
                 raise Refused(f"box {list(key)}: a box across an exit face is neither OUT, a sink nor an earlier "
                               "retracting box")
-        if not holds_on_box(_box(domain, key), lambda s: retracts(model, s, sign, evec[code])):
-            raise Refused(f"box {list(key)}: the retraction along {list(dirs[code][:3])} is not proved")
         resolved.add(key)
-        n_ret += 1
+
+
+def check_aspect_connected(model: ArbModel, claim: dict, prec: int) -> tuple[str, dict]:
+    """Re-prove one ``aspect_connected`` claim (module docstring); facts: aspect_sign, connected, empty.
+
+    The combinatorial steps (domain, tiling, sinks, order) come first, the arb proofs box by box last.
+    """
+    aspect, sign = read_aspect(claim)
+    domain = read_hex_box(get(claim, "domain"), "domain")
+    dirs, rows = _read_rows(claim)
+    deepest = max(k[0] for k, _ in rows)
+    keys = {k for k, _ in rows}
+    if len(keys) != len(rows):
+        raise Refused("boxes: a box is listed twice")
+    _check_domain(model, domain, deepest)
+    _check_tiling(keys, deepest)
+    sinks = [k for k, code in rows if code == _SINK]
+    empty = all(code == _OUT for _, code in rows)
+    if not empty:
+        if not sinks or not _sinks_connected(keys, sinks, deepest):
+            raise Refused("the sink boxes are not one nonempty face-connected set")
+        _check_order(keys, rows, dirs, deepest)
+    evec = [(arb(a), arb(b), arb(c) / div) for a, b, c, div in dirs]
+    for key, code in rows:
+        box = _box(domain, key)
+        if code == _OUT:
+            ok, what = holds_on_box(box, lambda s: _beyond_or_opposite(model, s, sign)), f"free of {aspect}"
+        elif code == _SINK:
+            ok, what = holds_on_box(box, lambda s: _in_aspect(model, s, sign)), f"inside {aspect}"
+        else:
+            ok = holds_on_box(box, lambda s: retracts(model, s, sign, evec[code]))
+            what = f"retracting along {list(dirs[code][:3])}"
+        if not ok:
+            raise Refused(f"box {list(key)}: not proved {what}")
+    if empty:
+        return f"every box of the cover is proved free of {aspect}: {aspect} is empty", \
+            {"aspect_sign": sign, "connected": False, "empty": True}
+    n_ret = sum(1 for _, code in rows if code >= 0)
     return (f"{aspect} is nonempty and connected: {len(rows)} boxes tile the domain ({len(sinks)} sinks, face-"
             f"connected, inside {aspect}; {n_ret} retract along certified monotone directions onto them in order; "
             f"the rest are free of {aspect})"), {"aspect_sign": sign, "connected": True, "empty": False}

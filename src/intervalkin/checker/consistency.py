@@ -64,17 +64,22 @@ def _count(v: Any, what: str) -> int:
     return v
 
 
-def check_found(name: str, found: Any, proved: int) -> None:
-    """Refuse a claim whose library count ``found`` is below the lower bound ``proved`` by the verified claims."""
+def check_found(name: str, found: Any, proved: int, proved_upper: int | None = None) -> None:
+    """Refuse a claim whose library count ``found`` is below the lower bound ``proved`` by the verified claims,
+    or above the upper bound ``proved_upper`` they prove (None: none proved)."""
     if found is None:
         return
     found = _count(found, "found")
     if found < proved:
         raise Refused(f"the library found {found} {name.replace('_', ' ')}, below the {proved} that the verified "
                       "claims prove: the count contradicts its certificates")
+    if proved_upper is not None and found > proved_upper:
+        raise Refused(f"the library found {found} {name.replace('_', ' ')}, above the {proved_upper} that the "
+                      "verified claims prove: the count contradicts its certificates")
 
 
-def check_summary_block(name: str, claim: dict, proved: int, summary: dict | None) -> str:
+def check_summary_block(name: str, claim: dict, proved: int, summary: dict | None,
+                        proved_upper: int | None = None) -> str:
     """Compare the ``name`` block of summary.json with its counts claim; the text to add to the verdict.
 
     Raises :class:`Refused` on a contradiction.  Returns "" when there is no
@@ -106,10 +111,12 @@ def check_summary_block(name: str, claim: dict, proved: int, summary: dict | Non
         problems.append(f"count {count} below the {proved} the verified claims prove")
     if upper is not None and (upper < count or upper < proved):
         problems.append(f"upper_bound {upper} below the count {count} or the proved {proved}")
+    if upper != claim.get("upper_bound"):
+        problems.append(f"upper_bound {upper} but the claim declares {claim.get('upper_bound')}")
+    if upper is not None and (proved_upper is None or upper < proved_upper):
+        problems.append(f"upper_bound {upper} is not what the certificates prove ({proved_upper})")
     if exact is not (upper is not None and upper == lower):
         problems.append(f"exact is {exact!r} with bounds {lower}..{upper}")
-    elif exact:
-        problems.append("exact, but the certificates prove no upper bound")
     if problems:
         raise Refused(f"{SUMMARY} contradicts the certificates on {name}: " + "; ".join(problems))
     return f"; {SUMMARY} agrees (count {count}, lower bound {lower})"

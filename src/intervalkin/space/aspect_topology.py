@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.status import Count
 from intervalkin.paving.adjacency import component_labels, shares_face
 from intervalkin.paving.tree import box_bounds, split_boxes, workspace_paving_domain
 from intervalkin.space.aspect_retraction import DIRECTIONS, classify_boxes, exit_faces, shared_direction
@@ -116,6 +117,23 @@ class AspectTopology:
     @property
     def seconds(self) -> float:
         return sum(c.seconds for c in self.covers)
+
+    def count(self, found: Count) -> Count:
+        """The aspect count ``found`` (its lower bound from opposite signs) with this upper bound added."""
+        upper = self.upper
+        if upper is None or upper < found.found:
+            left = sum(len(c.leftovers()) for c in self.covers)
+            return Count(found.found, found.lower, None, False, found.why + f"; the covers of the two signs leave "
+                         f"{left} boxes undecided (listed under \"covers\"), so no upper bound is proved")
+        return Count(found.found, found.lower, upper, upper == found.lower,
+                     f"at least {found.lower}: opposite certified signs of det A; at most {upper}: for each sign, a "
+                     "cover of the domain by boxes free of it, inside it (one face-connected set of sinks) or "
+                     "retracting onto the sinks along certified monotone directions proves its part of W "
+                     "connected (proofs/lemma-aspect-retraction.md)")
+
+    def to_json(self) -> dict:
+        return {"upper_bound": self.upper, "covers": {("WA1" if c.sign > 0 else "WA2"): c.to_json()
+                                                      for c in self.covers}}
 
 
 def face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
