@@ -185,25 +185,36 @@ def resolve_cover(level, ijk, depth, out, inside, ok, custom_faces, volume):
         sink = comp == int(np.argmax(vol))
     ok = ok.copy()
     ok[inside & ~sink, :len(DIRECTIONS)] = True  # the fixed directions only (a per-box one may be 0)
-    fixed_faces = exit_faces(DIRECTIONS).astype(np.uint8)  # (m, 6)
+    fixed_faces = exit_faces(DIRECTIONS).astype(np.uint8).T  # (6, m)
     resolved = out | sink
     rank = np.where(resolved, 0, -1)
     choice = np.full(n, -1, dtype=np.int64)
+    # open[a, f]: neighbours across face f of a not resolved yet (a worklist: only boxes next to the
+    # boxes resolved at the last step can change)
+    opened = np.zeros((n, 6), dtype=np.int64)
+    nb = ~resolved[pairs[1]]
+    np.add.at(opened, (pairs[0][nb], pairs[2][nb]), 1)
+    frontier = np.flatnonzero(~resolved)
     step = 0
-    while True:
+    while frontier.size:
         step += 1
-        bad = border.copy()
-        nb = ~resolved[pairs[1]]
-        bad[pairs[0][nb], pairs[2][nb]] = True
-        blocked = np.concatenate([(bad.astype(np.uint8) @ fixed_faces.T) > 0,
-                                  np.any(custom_faces & bad[:, None, :], axis=-1)], axis=1)
-        good = ok & ~blocked & ~resolved[:, None]
-        new = np.any(good, axis=1)
-        if not np.any(new):
+        bad = border[frontier] | (opened[frontier] > 0)
+        blocked = np.concatenate([(bad.astype(np.uint8) @ fixed_faces) > 0,
+                                  np.any(custom_faces[frontier] & bad[:, None, :], axis=-1)], axis=1)
+        good = ok[frontier] & ~blocked
+        hit = np.any(good, axis=1)
+        new = frontier[hit]
+        if new.size == 0:
             break
-        choice[new] = np.argmax(good[new], axis=1)
+        choice[new] = np.argmax(good[hit], axis=1)
         rank[new] = step
-        resolved |= new
+        resolved[new] = True
+        now = np.zeros(n, dtype=bool)
+        now[new] = True
+        sel = now[pairs[1]]
+        np.subtract.at(opened, (pairs[0][sel], pairs[2][sel]), 1)
+        touched = np.unique(pairs[0][sel])
+        frontier = touched[~resolved[touched]]
     kind = np.full(n, LEFT, dtype=np.uint8)
     kind[out] = OUT
     kind[sink] = SINK
