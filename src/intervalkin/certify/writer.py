@@ -99,6 +99,7 @@ with the reason (it is never written as if it held).
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Sequence
 
@@ -211,6 +212,9 @@ def write_certificates(
         # the counts lean on exactly the solves the library counted from (the joint cells' witnesses): an
         # extra solve (Table 1's) could prove a larger bound than the count printed beside it
         solve_refs = [f"joint_cell.json#{c['id']}" for c in files.get("joint_cell", [])]
+        if counts is None and aspect_topology is not None:
+            counts = regions.counts()
+            counts = dataclasses.replace(counts, aspects=aspect_topology.count(counts.aspects))
         files["counts"] = counts_claims(regions, aspect_refs, solve_refs, counts)
 
     written = []

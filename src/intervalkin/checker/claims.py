@@ -293,7 +293,8 @@ def check_count(claim: dict, verified: dict[str, dict], summary: dict | None = N
             raise Refused(f"declared upper bound {declared_upper} is not backed: the verified supporting claims "
                           f"prove {'no upper bound' if upper is None else f'at most {upper}'}")
     if claim.get("exact") is not (declared_upper is not None and declared_upper == declared):
-        raise Refused(f"exact is {claim.get('exact')!r} with declared bounds {declared}..{declared_upper}")
+        raise Refused(f"exact is {claim.get('exact')!r} with declared bounds {declared}..{declared_upper}: a count "
+                      "is exact exactly when a proved upper bound meets its lower bound")
     found = claim.get("found")
     check_found(name, found, bound, upper)
     extra = f"; {found} found by the library" if found is not None else ""
