@@ -8,13 +8,14 @@ printed, these must hold, and :func:`check_found` refuses the claim otherwise:
 * ``lower_bound <= proved`` (the declared bound is backed; checked in ``claims``);
 * ``found >= proved``: a number of pieces found below a proved minimum is a
   contradiction (the pieces were miscounted, or a proof is wrong), never a
-  result to print.
+  result to print; likewise ``found <= proved upper bound`` when one is proved.
 
 When the certificate folder sits in an output folder (``DIR/certificates``
 beside ``DIR/summary.json``), the summary is what the user read, so
 :func:`check_summary_block` compares each count block with the claim: the same
-``count`` and ``lower_bound``, ``count >= lower_bound``, an ``upper_bound``
-(when one is given) not below them, and ``exact`` only when the two bounds meet.
+``count`` and ``lower_bound``, ``count >= lower_bound``, the claim's ``upper_bound``
+(when one is given: not below them, and backed by what the certificates prove),
+and ``exact`` only when the two bounds meet.
 A summary of a run that did not complete (``"complete": false``) is not
 compared, and the verdict says so.
 
