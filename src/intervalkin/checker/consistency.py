@@ -120,4 +120,6 @@ def check_summary_block(name: str, claim: dict, proved: int, summary: dict | Non
         problems.append(f"exact is {exact!r} with bounds {lower}..{upper}")
     if problems:
         raise Refused(f"{SUMMARY} contradicts the certificates on {name}: " + "; ".join(problems))
-    return f"; {SUMMARY} agrees (count {count}, lower bound {lower})"
+    bounds = f"lower bound {lower}" + ("" if upper is None else f", upper bound {upper}, exact" if exact
+                                       else f", upper bound {upper}")
+    return f"; {SUMMARY} agrees (count {count}, {bounds})"

@@ -24,10 +24,13 @@ the joins of fragments and the absence of hidden pieces come from one argument.
 
 How the cover is built: boxes are split top-down while neither OUT, IN nor
 retractable (up to ``start_depth``); then ranks are computed by a fixed point over
-the face adjacency (vectorized: one pass over the face pairs per rank); boxes left
-unresolved are split and re-classified, up to ``max_depth``.  Only the last step is
-iterated, so the cover stays small (a few ten thousand boxes where the paving has
-millions): the independent checker re-proves every box of it in arb.
+the face adjacency (a worklist: each rank looks only at the boxes beside those
+resolved at the rank before); clusters of unresolved boxes get one shared direction
+(corners of S_s), and what is still unresolved is split and re-classified, up to
+``max_depth``.  Only the unresolved boxes are refined, so the cover stays small
+(about 20 000 boxes per sign for the paper's manipulator, where the depth-8 paving
+has millions): the independent checker re-proves every box of it in arb.  Cost on
+the paper's manipulator: about 1 s per sign.
 """
 
 from __future__ import annotations
