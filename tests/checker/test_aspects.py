@@ -123,7 +123,7 @@ def test_a_cycle_a_hole_and_a_small_domain_are_refused(paper_geometry, claims):
 
 def test_counts_exact_only_with_both_signs_connected():
     """count_upper needs a verified cover for each sign; exact needs the declared bounds to meet."""
-    both = [{"signs": {1, -1}}, {"aspect_sign": 1, "connected": True}, {"aspect_sign": -1, "connected": True}]
+    both = [{"signs": {1, -1}}, {"aspect_sign": 1, "components_at_most": 1}, {"aspect_sign": -1, "components_at_most": 1}]
     assert count_upper("aspects", both) == 2
     assert count_upper("aspects", both[:2]) is None
     assert count_upper("basic_regions", both) is None

@@ -7,7 +7,7 @@ import numpy as np
 from intervalkin.core.status import Count, Status
 from intervalkin.paving.adjacency import component_labels, shares_face
 from intervalkin.space.aspect_retraction import DIRECTIONS, exit_faces
-from intervalkin.space.aspect_topology import LEFT, OUT, RET, SINK, AspectTopology, face_pairs
+from intervalkin.space.aspect_topology import LEFT, OUT, RET, SINK, AspectTopology, face_pairs, resolve_cover
 
 
 def test_the_paper_has_exactly_two_aspects(aspect_topology):
@@ -88,3 +88,23 @@ def test_an_open_cover_gives_no_upper_bound(aspect_topology):
 def test_directions_are_integer_and_nonzero():
     assert DIRECTIONS.dtype.kind == "i" and np.all(np.any(DIRECTIONS != 0, axis=1))
     assert len({tuple(d) for d in DIRECTIONS.tolist()}) == len(DIRECTIONS)
+
+
+def test_a_fragment_no_chain_reaches_becomes_another_group_of_sinks():
+    """Two IN boxes separated by boxes that retract nowhere: with one group the second stays LEFT; with two
+    groups allowed it becomes a second group of sinks (the bound is then 2 for this sign, not 1)."""
+    level = np.full(64, 2, dtype=np.int64)
+    ijk = np.array([[i, j, k] for i in range(4) for j in range(4) for k in range(4)], dtype=np.int64)
+    out = np.zeros(64, dtype=bool)
+    inside = np.zeros(64, dtype=bool)
+    first, second = 0, 2 * 16  # (0, 0, 0) and (2, 0, 0)
+    inside[[first, second]] = True
+    ok = np.zeros((64, len(DIRECTIONS) + 3), dtype=bool)
+    faces = np.zeros((64, 3, 6), dtype=bool)
+    vol = np.ones(64)
+    kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, 2, out, inside, ok, faces, vol)
+    assert fragments == 2 and groups == 1
+    assert sorted(kind[[first, second]].tolist()) == [SINK, LEFT]
+    kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, 2, out, inside, ok, faces, vol, 2)
+    assert groups == 2 and kind[first] == kind[second] == SINK
+    assert np.all(kind[~inside] == LEFT)

@@ -44,10 +44,10 @@ def aspect_cover_claim(cover: AspectCover) -> dict:
         "phi_divisor": PHI_DIVISOR,
         "directions": dirs.tolist(),
         "boxes": rows,
-        "statement": (f"{name} (the poses of W with det A {'>' if cover.sign > 0 else '<'} 0) is nonempty and "
-                      f"connected: these {len(rows)} boxes tile the paving domain; the sinks are face-connected and "
-                      f"inside {name}; every other box is free of {name} or retracts along its direction onto boxes "
-                      "listed before it"),
+        "statement": (f"{name} (the poses of W with det A {'>' if cover.sign > 0 else '<'} 0) is nonempty with "
+                      f"at most {cover.groups} component(s): these {len(rows)} boxes tile the paving domain; the "
+                      f"sinks lie inside {name} in {cover.groups} face-connected group(s); every other box is free "
+                      f"of {name} or retracts along its direction onto boxes listed before it"),
     }
 
 

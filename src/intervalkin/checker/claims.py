@@ -255,16 +255,16 @@ def count_bound(name: str, support: list[dict]) -> int:
 def count_upper(name: str, support: list[dict]) -> int | None:
     """The upper bound the verified support proves, None when it proves none (proofs/lemma-aspect-retraction.md).
 
-    * ``aspects``: when verified ``aspect_connected`` claims cover both signs of det A, the
-      number of signs whose part of W is proved nonempty and connected (a sign proved empty
-      adds none): each sign's part is one aspect.
+    * ``aspects``: when verified ``aspect_connected`` claims cover both signs of det A, the sum
+      of their bounds on the components of each sign's part of W (its groups of sinks; 0 for a
+      sign proved empty): every aspect is one such component.
     """
     if name != "aspects":
         return None
     by_sign = {f["aspect_sign"]: f for f in support if "aspect_sign" in f}
     if set(by_sign) != {1, -1}:
         return None
-    return sum(1 for f in by_sign.values() if f.get("connected"))
+    return sum(int(f["components_at_most"]) for f in by_sign.values())
 
 
 def check_count(claim: dict, verified: dict[str, dict], summary: dict | None = None) -> tuple[str, dict]:

@@ -53,6 +53,10 @@ __all__ = ["OUT", "SINK", "RET", "LEFT", "AspectCover", "AspectTopology", "face_
 OUT, SINK, RET, LEFT = 0, 1, 2, 3
 #: Refinement rounds of the unresolved boxes (each one splits them once).
 MAX_ROUNDS = 12
+#: No refinement round that would take a cover past this many boxes (what is unresolved then is reported).
+MAX_BOXES = 200_000
+#: Most groups of sinks a cover may use when one group cannot be reached from everywhere.
+MAX_GROUPS = 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,7 +67,8 @@ class AspectCover:
     ``direction`` (n, 3) int: e = (a, b, c / PHI_DIVISOR) of RET boxes (0 elsewhere);
     ``rank`` (n,): 0 for OUT and SINK, the step at which a RET box was resolved, -1 for LEFT.
     ``fragments``: face-connected components of IN boxes (before the joins by retraction).
-    ``connected``: no LEFT box and at least one sink: S_s is proved nonempty and connected.
+    ``groups``: face-connected groups of sinks (each is connected; every point reaches one).
+    ``connected``: no LEFT box and one group of sinks: S_s is proved nonempty and connected.
     ``empty``: every box is OUT: S_s is proved empty.
     """
 
@@ -75,11 +80,22 @@ class AspectCover:
     direction: np.ndarray
     rank: np.ndarray
     fragments: int
+    groups: int
     seconds: float
 
     @property
+    def closed(self) -> bool:
+        """No LEFT box: every point of S_s reaches a group of sinks, so S_s has at most ``groups`` components."""
+        return not np.any(self.kind == LEFT)
+
+    @property
+    def components_at_most(self) -> int | None:
+        """The proved upper bound on the number of components of S_s (None: the cover is open)."""
+        return self.groups if self.closed else None
+
+    @property
     def connected(self) -> bool:
-        return not np.any(self.kind == LEFT) and bool(np.any(self.kind == SINK))
+        return self.closed and self.groups == 1
 
     @property
     def empty(self) -> bool:
@@ -100,7 +116,7 @@ class AspectCover:
         kinds = {name: int(np.count_nonzero(self.kind == v)) for name, v in
                  (("out", OUT), ("sink", SINK), ("retract", RET), ("left", LEFT))}
         return {"sign": self.sign, "boxes": int(len(self.level)), "kinds": kinds, "inside_fragments": self.fragments,
-                "connected": self.connected, "empty": self.empty, "deepest_level": int(self.level.max()),
+                "sink_groups": self.groups, "components_at_most": self.components_at_most, "connected": self.connected, "empty": self.empty, "deepest_level": int(self.level.max()),
                 "longest_chain": int(self.rank.max()), "seconds": round(self.seconds, 3),
                 "leftovers": self.leftovers()[:20]}
 
@@ -113,9 +129,9 @@ class AspectTopology:
 
     @property
     def upper(self) -> int | None:
-        if not all(c.connected or c.empty for c in self.covers):
-            return None
-        return sum(1 for c in self.covers if c.connected)
+        """Sum over the signs of the proved bound on their components; None when a cover is open."""
+        bounds = [c.components_at_most for c in self.covers]
+        return None if any(b is None for b in bounds) else sum(bounds)
 
     @property
     def seconds(self) -> float:
@@ -128,11 +144,12 @@ class AspectTopology:
             left = sum(len(c.leftovers()) for c in self.covers)
             return Count(found.found, found.lower, None, False, found.why + f"; the covers of the two signs leave "
                          f"{left} boxes undecided (listed under \"covers\"), so no upper bound is proved")
+        groups = " + ".join(str(c.groups) for c in self.covers)
         return Count(found.found, found.lower, upper, upper == found.lower,
-                     f"at least {found.lower}: opposite certified signs of det A; at most {upper}: for each sign, a "
-                     "cover of the domain by boxes free of it, inside it (one face-connected set of sinks) or "
-                     "retracting onto the sinks along certified monotone directions proves its part of W "
-                     "connected (proofs/lemma-aspect-retraction.md)")
+                     f"at least {found.lower}: opposite certified signs of det A; at most {upper} = {groups}: for each "
+                     "sign, a cover of the domain by boxes free of it, inside it (face-connected groups of sinks) or "
+                     "retracting onto the sinks along certified monotone directions proves that its part of W has at "
+                     "most one component per group (proofs/lemma-aspect-retraction.md)")
 
     def to_json(self) -> dict:
         return {"upper_bound": self.upper, "covers": {("WA1" if c.sign > 0 else "WA2"): c.to_json()
@@ -170,59 +187,68 @@ def face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int) -> tuple[np.ndarr
     return pairs, border, edges
 
 
-def resolve_cover(level, ijk, depth, out, inside, ok, custom_faces, volume):
+def resolve_cover(level, ijk, depth, out, inside, ok, custom_faces, volume, max_groups: int = 1):
     """Sinks, ranks and chosen candidates of the boxes of one cover (numpy fixed point).
 
     The sinks are the face-connected component of IN boxes of largest volume; other IN boxes
-    take any fixed direction.  Returns (kind, rank, choice, fragments, edges); ``choice`` indexes
-    the candidate directions (-1: none), LEFT boxes are those no rank reached, ``edges`` the face
-    adjacency.
+    take any fixed direction.  When the fixed point stalls with IN boxes unresolved and fewer than
+    ``max_groups`` sink groups, the largest unresolved fragment of IN boxes becomes one more group
+    (each group is connected; the set is then proved to have at most that many components).
+    Returns (kind, rank, choice, fragments, edges, groups); ``choice`` indexes the candidate
+    directions (-1: none), LEFT boxes are those no rank reached, ``edges`` the face adjacency.
     """
     n = len(level)
     pairs, border, edges = face_pairs(level, ijk, depth)
     comp = component_labels(n, edges, inside)
     fragments = int(comp.max()) + 1 if np.any(inside) else 0
+    frag_vol = np.bincount(comp[inside], weights=volume[inside], minlength=fragments)
     sink = np.zeros(n, dtype=bool)
-    if fragments:
-        vol = np.bincount(comp[inside], weights=volume[inside], minlength=fragments)
-        sink = comp == int(np.argmax(vol))
+    groups = 0
     ok = ok.copy()
-    ok[inside & ~sink, :len(DIRECTIONS)] = True  # the fixed directions only (a per-box one may be 0)
+    ok[inside, :len(DIRECTIONS)] = True  # the fixed directions only (a per-box one may be 0)
     fixed_faces = exit_faces(DIRECTIONS).astype(np.uint8).T  # (6, m)
-    resolved = out | sink
+    resolved = out.copy()
     rank = np.where(resolved, 0, -1)
     choice = np.full(n, -1, dtype=np.int64)
-    # open[a, f]: neighbours across face f of a not resolved yet (a worklist: only boxes next to the
+    # opened[a, f]: neighbours across face f of a not resolved yet (a worklist: only boxes next to the
     # boxes resolved at the last step can change)
     opened = np.zeros((n, 6), dtype=np.int64)
     nb = ~resolved[pairs[1]]
     np.add.at(opened, (pairs[0][nb], pairs[2][nb]), 1)
-    frontier = np.flatnonzero(~resolved)
+    new = np.zeros(0, dtype=np.int64)
     step = 0
-    while frontier.size:
-        step += 1
+    while True:
+        if new.size == 0:  # stalled (or starting): one more sink group, if allowed and any IN box is left
+            left_in = inside & ~resolved
+            if groups >= max_groups or not np.any(left_in):
+                break
+            vols = np.where(np.bincount(comp[left_in], minlength=fragments) > 0, frag_vol, -1.0)
+            new = np.flatnonzero(comp == int(np.argmax(vols)))
+            sink[new] = True
+            rank[new] = 0
+            groups += 1
+        else:
+            step += 1
+            rank[new] = step
+        resolved[new] = True
+        now = np.zeros(n, dtype=bool)
+        now[new] = True
+        sel = now[pairs[1]]
+        np.subtract.at(opened, (pairs[0][sel], pairs[2][sel]), 1)
+        touched = np.flatnonzero(~resolved) if groups == 1 and step == 0 else np.unique(pairs[0][sel])
+        frontier = touched[~resolved[touched]]
         bad = border[frontier] | (opened[frontier] > 0)
         blocked = np.concatenate([(bad.astype(np.uint8) @ fixed_faces) > 0,
                                   np.any(custom_faces[frontier] & bad[:, None, :], axis=-1)], axis=1)
         good = ok[frontier] & ~blocked
         hit = np.any(good, axis=1)
         new = frontier[hit]
-        if new.size == 0:
-            break
         choice[new] = np.argmax(good[hit], axis=1)
-        rank[new] = step
-        resolved[new] = True
-        now = np.zeros(n, dtype=bool)
-        now[new] = True
-        sel = now[pairs[1]]
-        np.subtract.at(opened, (pairs[0][sel], pairs[2][sel]), 1)
-        touched = np.unique(pairs[0][sel])
-        frontier = touched[~resolved[touched]]
     kind = np.full(n, LEFT, dtype=np.uint8)
     kind[out] = OUT
     kind[sink] = SINK
     kind[(rank > 0)] = RET
-    return kind, rank, choice, fragments, edges
+    return kind, rank, choice, fragments, edges, groups
 
 
 def _classified(geometry, domain, level, ijk, sign):
@@ -267,15 +293,20 @@ def cover_aspect(geometry: Geometry, sign: int, start_depth: int = 9, max_depth:
             break
         level, ijk = split_boxes(level[cut], ijk[cut])
     level, ijk, out, inside, ok, custom, vol = (np.concatenate(p) for p in zip(*parts))
-    for _ in range(MAX_ROUNDS):
+    for rnd in range(MAX_ROUNDS + 1):
         depth = max(int(level.max()), 1)
-        kind, rank, choice, fragments, edges = resolve_cover(level, ijk, depth, out, inside, ok, exit_faces(custom), vol)
+        faces = exit_faces(custom)
+        kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, depth, out, inside, ok, faces, vol)
         if np.any(kind == LEFT):
             _share_directions(geometry, domain, level, ijk, kind, edges, sign, ok, custom)
-            kind, rank, choice, fragments, edges = resolve_cover(level, ijk, depth, out, inside, ok,
-                                                                 exit_faces(custom), vol)
+            faces = exit_faces(custom)
+            kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, depth, out, inside, ok,
+                                                                         faces, vol)
         cut = (kind == LEFT) & (level < max_depth)
-        if not np.any(cut):
+        if rnd == MAX_ROUNDS or not np.any(cut) or len(level) + 7 * int(cut.sum()) > MAX_BOXES:
+            if np.any(kind == LEFT):  # what one group of sinks cannot reach: more groups (a weaker bound)
+                kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, depth, out, inside, ok,
+                                                                             faces, vol, MAX_GROUPS)
             break
         cl, cijk = split_boxes(level[cut], ijk[cut])
         lab = _classified(geometry, domain, cl, cijk, sign)
@@ -287,7 +318,7 @@ def cover_aspect(geometry: Geometry, sign: int, start_depth: int = 9, max_depth:
     j = choice[rows]
     m = len(DIRECTIONS)
     direction[rows] = np.where((j < m)[:, None], DIRECTIONS[np.minimum(j, m - 1)], custom[rows, np.clip(j - m, 0, 2)])
-    return AspectCover(sign, domain, level.astype(np.int64), ijk, kind, direction, rank, fragments,
+    return AspectCover(sign, domain, level.astype(np.int64), ijk, kind, direction, rank, fragments, groups,
                        time.perf_counter() - t0)
 
 
