@@ -50,3 +50,11 @@ def regions_chain(paper_geometry):
     """The chain shared by space/test_basic_region.py and space/test_basic_region_properties.py
     (built once, about 8 s): workspace depth 7, joint grid 2**6, regions at depth 7."""
     return small_chain(paper_geometry, 7, 6, 7, max_solves=200)
+
+
+@pytest.fixture(scope="session")
+def aspect_topology(paper_geometry):
+    """The covers proving each sign's part of W connected on the paper's manipulator (about 2 s)."""
+    from intervalkin.space.aspect_topology import prove_aspects
+
+    return prove_aspects(paper_geometry)

@@ -77,7 +77,7 @@ def test_analyse_prints_nothing_and_reports_progress(capfd):
     assert out == "" and err == ""
     starts = [e.stage for e in events if e.kind == "start"]
     dones = [e.stage for e in events if e.kind == "done"]
-    assert starts == dones == list(a.timings) and len(starts) == 4
+    assert starts == dones == list(a.timings) and len(starts) == 5
     levels = [e for e in events if e.kind == "level"]
     assert levels and all({"level", "depth", "boxes", "split"} <= set(e.level) for e in levels)
     assert a.depth == 4 and a.singular_depth == 5 and a.joint_depth == 3
@@ -125,10 +125,12 @@ def test_count_status_and_json():
 
 def test_analysis_counts(analysis):
     c = analysis.counts()
-    for count in (c.aspects, c.basic_regions, c.uniqueness_domains):
+    for count in (c.basic_regions, c.uniqueness_domains):
         assert count.lower <= count.found and count.upper is None and not count.exact
         assert count.status is Status.LOWER_BOUND and count.why
-    assert c.aspects.found == c.aspects.lower == 2
+    # the aspects: 2 proved from below (opposite signs) and from above (each sign's cover closes)
+    assert (c.aspects.found, c.aspects.lower, c.aspects.upper, c.aspects.exact) == (2, 2, 2, True)
+    assert c.aspects.status is Status.CERTIFIED
     # basic regions: counted over every cell of the direct joint paving (Theorem 1), never below the bound
     from_cells = sum(cell.count for cell in analysis.cells.cells if cell.count >= 0)
     assert c.basic_regions.found == max(from_cells, c.basic_regions.lower)

@@ -118,12 +118,15 @@ def test_summary_lower_bounds_are_the_certified_ones(summary, run, verified):
     _, lines, _ = verified
     for name in COUNTS:
         s = summary[name]
-        assert isinstance(s["count"], int) and isinstance(s["lower_bound"], int) and s["exact"] is False
+        assert isinstance(s["count"], int) and isinstance(s["lower_bound"], int)
+        assert s["exact"] is (name == "aspects")  # the aspects also have a proved upper bound
         assert s["lower_bound"] == counts[name]["lower_bound"]
+        assert s["upper_bound"] == counts[name]["upper_bound"]
         line = next(ln for ln in lines if f"counts.json#{name} " in ln)
         proved = int(re.search(r"prove >= (\d+)", line).group(1))
         assert s["lower_bound"] <= proved
-    assert summary["aspects"]["lower_bound"] == 2
+    assert summary["aspects"]["lower_bound"] == summary["aspects"]["upper_bound"] == 2
+    assert any("aspect_connected.json#WA1" in ln and "nonempty and connected" in ln for ln in lines)
 
 
 def test_found_counts_never_sit_below_their_lower_bounds(summary):

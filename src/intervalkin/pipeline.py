@@ -47,6 +47,7 @@ from intervalkin.core.geometry import Geometry, default_geometry
 from intervalkin.core.status import Status
 from intervalkin.paving.budget import check_depth
 from intervalkin.solve import dkp
+from intervalkin.space.aspect_topology import AspectTopology, prove_aspects
 from intervalkin.space.basic_region import (
     RegionAnalysis,
     RegionCounts,
@@ -150,6 +151,7 @@ class Analysis:
     regions : aspects, pieces, basic regions, witnesses, uniqueness domains, per box and in all.
     timings : seconds per stage, keyed by the stage names of the progress events.
     refinement : each depth the regions paving was tried at, and why it stopped.
+    aspect_topology : the covers proving each sign's part of W connected (the aspects' upper bound).
     """
 
     geometry: Geometry
@@ -161,6 +163,7 @@ class Analysis:
     regions: RegionAnalysis
     timings: Mapping[str, float]
     refinement: tuple[RefinementStep, ...]
+    aspect_topology: AspectTopology | None = None
 
     @property
     def n_singular_boxes(self) -> int:
@@ -175,7 +178,9 @@ class Analysis:
         that happen to receive certified workspace boxes.
         """
         counts = self.regions.counts()
-        return dataclasses.replace(counts, basic_regions=regions_from_cells(self.cells.cells, counts.basic_regions.lower))
+        aspects = counts.aspects if self.aspect_topology is None else self.aspect_topology.count(counts.aspects)
+        return dataclasses.replace(counts, aspects=aspects,
+                                   basic_regions=regions_from_cells(self.cells.cells, counts.basic_regions.lower))
 
     def label(self, pose: Sequence, refine: bool = True) -> PoseLabel:
         """Certified aspect, basic region and uniqueness domain of a pose (x, y, phi), read exactly.
@@ -225,7 +230,8 @@ class Analysis:
         :func:`verify` re-proves every claim from the files alone.
         """
         return write_certificates(folder, self.geometry, dkp_results=dkp_results, joint=self.joint,
-                                  regions=self.regions, trajectories=trajectories, counts=self.counts())
+                                  regions=self.regions, trajectories=trajectories, counts=self.counts(),
+                                  aspect_topology=self.aspect_topology)
 
 
 @dataclass(frozen=True)
@@ -355,6 +361,8 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
                 cells = pave_joint_cells(geometry, dj, JOIN_LEVELS, progress=levels)
         with stages.stage(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})") as levels:
             regions = analyse_regions(geometry, joint, dw, progress=levels)
+        with stages.stage("aspects: covers proving each sign of det A connected"):
+            topology = prove_aspects(geometry)
         if future is not None:
             with stages.stage(name + ", in a second process: waiting for it"):
                 cells = future.result()
@@ -371,7 +379,7 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     else:
         stopped = f"limit reached (depth {dw}) before consistency"
     history[-1] = dataclasses.replace(history[-1], stopped=stopped)
-    return Analysis(geometry, dw, ds, dj, joint, cells, regions, dict(stages.timings), tuple(history))
+    return Analysis(geometry, dw, ds, dj, joint, cells, regions, dict(stages.timings), tuple(history), topology)
 
 
 def verify(path: str | Path) -> VerifyReport:

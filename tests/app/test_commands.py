@@ -28,9 +28,14 @@ def test_outputs_and_summary_schema(analysed):
     assert s["aspects"]["count"] == 2 and s["aspects"]["lower_bound"] == 2
     for key in ("aspects", "basic_regions", "uniqueness_domains"):
         assert {"count", "exact", "lower_bound", "upper_bound", "why"} <= set(s[key])
-        # a count never falls below its certified lower bound; none is exact without an upper bound
+        # a count never falls below its certified lower bound; none is exact without an upper bound (the aspects
+        # have one: each sign's cover closes)
         assert 0 <= s[key]["lower_bound"] <= s[key]["count"]
-        assert s[key]["exact"] is False and s[key]["upper_bound"] is None
+        if key == "aspects":
+            assert s[key]["exact"] is True and s[key]["upper_bound"] == 2
+            assert {c["components_at_most"] for c in s[key]["covers"].values()} == {1}
+        else:
+            assert s[key]["exact"] is False and s[key]["upper_bound"] is None
     with np.load(analysed / "pavings" / "workspace.npz") as z:
         assert {"lo", "hi", "depth", "in_workspace", "det_sign", "aspect", "basic_region", "uniqueness_domain"} <= set(z.files)
         n = z["lo"].shape[0]

@@ -33,6 +33,20 @@ def _status(block: dict) -> str:
     return f"found {block['count']}; certified lower bound {block['lower_bound']}"
 
 
+def _aspect_upper_text(block: dict) -> str:
+    """What the covers of the two signs prove (summary block of the aspects)."""
+    covers = block.get("covers", {})
+    if block.get("upper_bound") is None:
+        left = sum(c["kinds"]["left"] for c in covers.values())
+        return (f"No upper bound is proved: the covers leave {left} boxes undecided." if covers else
+                "That no third aspect hides in the undecided layer is not proved.")
+    parts = ", ".join(f"{name}: {c['boxes']} boxes, {c['inside_fragments']} fragments of certified boxes joined"
+                      for name, c in covers.items())
+    return (f"At most {block['upper_bound']}: for each sign a cover of the domain ({parts}) proves that sign's "
+            "part of W connected: every box is free of the aspect, inside it, or retracts onto one connected set "
+            f"of inside boxes along a certified monotone direction. The count is exact: {block['upper_bound']}.")
+
+
 def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
     """Write ``report.md``: each claim of the paper beside the certified result. Returns its name."""
 
@@ -100,8 +114,8 @@ def write_report(analysis: Analysis, summary: dict, out, timings: dict) -> str:
       f"certified det A > 0 boxes and {per['WA2']} of det A < 0; the largest of each sign hold "
       + ", ".join(f"{d['volume']:.1f} ({d['aspect']})" for d in big)
       + " of volume, the others are small fragments cut off by the undecided layer. Two aspects are "
-      "certified different (opposite det A signs): a lower bound of 2. That no third aspect hides in the "
-      "undecided layer is not proved.\n")
+      "certified different (opposite det A signs): a lower bound of 2. "
+      + _aspect_upper_text(summary["aspects"]) + "\n")
     for number in (3, 5, 6):
         a(figure_passage(number, analysis, summary, files))
 

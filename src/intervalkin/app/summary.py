@@ -27,7 +27,9 @@ CERTIFIED_NOTE = {
     "connected": "Each component is a union of face-adjacent certified boxes (phi wraps): certified connected.",
     "distinct": "Components of opposite det A signs lie in different aspects (the sign is the witness). "
                 "Components of the same sign are NOT proved distinct: they may join through the undecided layer; "
-                "their count is an upper bound of the aspects of that sign found at this depth.",
+                "their count is an upper bound of the aspects of that sign found at this depth. The aspect count "
+                "itself is bounded from above by the covers under aspects.covers (each sign's part of W proved "
+                "connected).",
 }
 
 
@@ -133,6 +135,8 @@ def chain_summary(a: Analysis) -> dict:
     p = ra.paving
     out = a.counts().to_json()
     out["basic_regions"]["seen_in_workspace"] = len(ra.regions)
+    if a.aspect_topology is not None:
+        out["aspects"]["covers"] = a.aspect_topology.to_json()["covers"]
     out.update(
         {
             "geometry": a.geometry.name,

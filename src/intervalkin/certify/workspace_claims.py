@@ -12,8 +12,8 @@
   :func:`intervalkin.checker.sample_indices` from a seed, with their W and det A
   labels, each re-provable over the whole box.
 * ``counts``: the library's counts of aspects, basic regions and uniqueness
-  domains, each with the lower bound its supporting claims prove and
-  ``exact`` false (no upper bound is certified).
+  domains, each with the lower bound its supporting claims prove, and the
+  upper bound where one is certified (the aspects, by ``aspect_connected``).
 """
 
 from __future__ import annotations
@@ -165,14 +165,17 @@ def counts_claims(analysis, aspect_refs: Sequence[str], solve_refs: Sequence[str
         ("uniqueness_domains", solve_refs, "the solutions of one joint vector in one aspect lie in different "
                                            "uniqueness domains of that aspect"),
     ):
+        upper = c[name].get("upper_bound")
         out.append({
             "id": name,
             "name": name,
             "lower_bound": int(c[name]["lower_bound"]),
+            "upper_bound": None if upper is None else int(upper),
             "found": int(c[name]["count"]),
-            "exact": False,
+            "exact": bool(c[name]["exact"]),
             "support": list(refs),
             "statement": f"at least {c[name]['lower_bound']} {name.replace('_', ' ')} ({why}); "
-                         f"{c[name]['count']} found, not proved exact",
+                         + (f"at most {upper} (each sign's part of W proved connected); exactly {upper}"
+                            if c[name]["exact"] else f"{c[name]['count']} found, not proved exact"),
         })
     return out

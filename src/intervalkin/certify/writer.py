@@ -77,11 +77,20 @@ Claim fields by kind (``id`` is unique within its file):
     of its end enclosure, keep det A of the aspect's sign and every leg within
     its limits; they join end to end from the exact start solution to the
     exact goal solution.
+``aspect_connected``
+    one claim per sign of det A (id and ``aspect`` "WA1" or "WA2"): ``domain``
+    (hex floats), ``phi_divisor``, ``directions`` ([a, b, c] integers: e = (a, b,
+    c / phi_divisor)) and ``boxes``: rows ``[level, i, j, k, code]`` of octree
+    coordinates, code -1 OUT, -2 SINK, d >= 0 retracting along directions[d],
+    OUT and SINK rows first, then retracting rows so that every box across an
+    exit face comes earlier (:mod:`intervalkin.certify.aspect_claims`).  Proves:
+    the aspect's part of W is nonempty and connected (checker.aspects).
 ``counts``
     one claim per count: ``name`` (``aspects``, ``basic_regions``,
-    ``uniqueness_domains``), ``lower_bound``, ``found`` (the library's number,
-    not certified), ``exact`` (always false), ``support`` (references
-    ``"file#id"`` to the claims that prove the bound).
+    ``uniqueness_domains``), ``lower_bound``, ``upper_bound`` (null: none
+    declared), ``found`` (the library's number), ``exact`` (true only when the
+    two bounds meet), ``support`` (references ``"file#id"`` to the claims that
+    prove the bounds).
 
 Writers build each solve claim, then run the checker on it before writing; a
 claim the checker refuses is left out and listed under ``omitted`` in the index
@@ -90,9 +99,11 @@ with the reason (it is never written as if it held).
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Sequence
 
+from intervalkin.certify.aspect_claims import aspect_connected_claims
 from intervalkin.certify.solve_claims import (
     dkp_claim,
     joint_cell_claims,
@@ -126,6 +137,7 @@ def write_certificates(
     precision: int = 128,
     trajectories: Sequence = (),
     counts=None,
+    aspect_topology=None,
 ) -> list[Path]:
     """Write the certificate folder of the given results; return the paths written (index last).
 
@@ -148,6 +160,10 @@ def write_certificates(
     counts : the :class:`~intervalkin.space.basic_region.RegionCounts` to declare (default:
         ``regions.counts()``); the pipeline passes its own, whose basic regions are counted
         over the cells of the direct joint paving.
+    aspect_topology : :class:`~intervalkin.space.aspect_topology.AspectTopology` ->
+        ``aspect_connected.json`` (one claim per sign whose cover closed).  These claims are
+        large (tens of thousands of boxes, several seconds of arb) and are written without the
+        pre-check: ``intervalkin verify`` re-proves them.
 
     Every solve claim is re-checked with :mod:`intervalkin.checker` before it
     is written; refused ones are listed under ``omitted`` in ``index.json``.
@@ -186,11 +202,19 @@ def write_certificates(
         trj, om = trajectory_claims(geometry, trajectories, precision)
         omitted += om
         files["trajectory"] = trj
+    if aspect_topology is not None:
+        conn, om = aspect_connected_claims(aspect_topology)
+        omitted += om
+        files["aspect_connected"] = conn
     if regions is not None:
         aspect_refs = [f"aspect_distinct.json#{c['id']}" for c in files.get("aspect_distinct", [])]
+        aspect_refs += [f"aspect_connected.json#{c['id']}" for c in files.get("aspect_connected", [])]
         # the counts lean on exactly the solves the library counted from (the joint cells' witnesses): an
         # extra solve (Table 1's) could prove a larger bound than the count printed beside it
         solve_refs = [f"joint_cell.json#{c['id']}" for c in files.get("joint_cell", [])]
+        if counts is None and aspect_topology is not None:
+            counts = regions.counts()
+            counts = dataclasses.replace(counts, aspects=aspect_topology.count(counts.aspects))
         files["counts"] = counts_claims(regions, aspect_refs, solve_refs, counts)
 
     written = []

@@ -27,6 +27,7 @@ What each claim type proves, and what it still trusts, is in
 Modules: :mod:`~intervalkin.checker.parse` (reading fields exactly),
 :mod:`~intervalkin.checker.model` (the arb model), :mod:`~intervalkin.checker.labels`
 (box labels), :mod:`~intervalkin.checker.solutions` (direct kinematics),
+:mod:`~intervalkin.checker.aspects` and :mod:`~intervalkin.checker.taylor` (aspect covers),
 :mod:`~intervalkin.checker.trajectory` (motions), :mod:`~intervalkin.checker.claims`
 (one check per kind, counts), :mod:`~intervalkin.checker.consistency` (counts against
 their proofs and the summary), :mod:`~intervalkin.checker.folder` (a whole folder).
@@ -72,11 +73,22 @@ Re-proved per claim type
     pieces tile [0, 1]; consecutive segments share their end enclosure; the
     start enclosure lies in the first segment's start, and the goal enclosure
     shifted by 2 pi phi_turns (phi unwrapped) in the last segment's end.
+``aspect_connected``
+    A cover of the paving domain by octree boxes, each OUT (no point of the
+    aspect's sign), SINK (inside it) or retracting along an exact direction:
+    the domain holds W, the boxes tile it, the sinks are face-connected, the
+    boxes across each exit face come earlier in the list, and every box's kind
+    is re-proved in arb (:mod:`~intervalkin.checker.aspects`, Taylor forms of
+    :mod:`~intervalkin.checker.taylor`): that sign's part of W is nonempty and
+    connected (proofs/lemma-aspect-retraction.md).
 ``counts``
     Each declared lower bound is recomputed from the referenced claims that
     verified (rules in :func:`~intervalkin.checker.claims.count_bound`); a
-    declared lower bound larger than the recomputed one, a count declared
-    exact, or a library count ``found`` below the recomputed bound is refused.
+    declared lower bound larger than the recomputed one, a declared upper
+    bound the verified claims do not back (:func:`~intervalkin.checker.claims.count_upper`:
+    the aspects, from an ``aspect_connected`` claim of each sign), a count
+    declared exact whose bounds do not meet, or a library count ``found``
+    outside the proved bounds is refused.
     When the folder is ``DIR/certificates`` of an output folder, the count
     blocks of ``DIR/summary.json`` (what the user was shown) must agree with
     the claims: same count and lower bound, no count below a proved bound, no

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from flint import ctx
 
+from intervalkin.checker.aspects import check_aspect_connected
 from intervalkin.checker.consistency import check_found, check_summary_block
 from intervalkin.checker.labels import (
     det_negative,
@@ -42,7 +43,8 @@ from intervalkin.checker.solutions import check_solutions
 from intervalkin.checker.trajectory import check_trajectory
 from intervalkin.core.geometry import Geometry
 
-__all__ = ['CHECKS', 'MALFORMED', 'check_claim', 'run_check', 'malformed_message', 'check_count', 'count_bound']
+__all__ = ['CHECKS', 'MALFORMED', 'check_claim', 'run_check', 'malformed_message', 'check_count', 'count_bound',
+           'count_upper']
 
 #: Errors that mean a field had an unexpected type or value: the claim is malformed (refused, not crashed on).
 MALFORMED = (TypeError, KeyError, AttributeError, ValueError, OverflowError, ZeroDivisionError)
@@ -185,6 +187,7 @@ CHECKS = {
     "region_distinct": _check_region_distinct,
     "box_labels": _check_box_labels,
     "trajectory": check_trajectory,
+    "aspect_connected": check_aspect_connected,
 }
 
 
@@ -249,6 +252,21 @@ def count_bound(name: str, support: list[dict]) -> int:
     raise Refused(f"unknown count {name!r} (known: aspects, basic_regions, uniqueness_domains)")
 
 
+def count_upper(name: str, support: list[dict]) -> int | None:
+    """The upper bound the verified support proves, None when it proves none (proofs/lemma-aspect-retraction.md).
+
+    * ``aspects``: when verified ``aspect_connected`` claims cover both signs of det A, the sum
+      of their bounds on the components of each sign's part of W (its groups of sinks; 0 for a
+      sign proved empty): every aspect is one such component.
+    """
+    if name != "aspects":
+        return None
+    by_sign = {f["aspect_sign"]: f for f in support if "aspect_sign" in f}
+    if set(by_sign) != {1, -1}:
+        return None
+    return sum(int(f["components_at_most"]) for f in by_sign.values())
+
+
 def check_count(claim: dict, verified: dict[str, dict], summary: dict | None = None) -> tuple[str, dict]:
     """Re-check one ``counts`` claim against the facts of the claims verified so far ("file#id" -> facts).
 
@@ -259,20 +277,31 @@ def check_count(claim: dict, verified: dict[str, dict], summary: dict | None = N
     """
     name = get(claim, "name")
     declared = read_int(get(claim, "lower_bound"), "lower_bound", 0)
-    if claim.get("exact") is not False:
-        raise Refused("a count declared exact (or without \"exact\": false) needs an upper bound "
-                      "this checker cannot verify")
     refs = get(claim, "support")
     if not isinstance(refs, list):
         raise Refused("support: expected a list of claim references \"file#id\"")
     used = [verified[r] for r in refs if r in verified]
     bound = count_bound(name, used)
+    upper = count_upper(name, used)
     if declared > bound:
         raise Refused(f"declared lower bound {declared} exceeds {bound}, what the {len(used)} verified "
                       f"supporting claims (of {len(refs)} referenced) prove")
+    declared_upper = claim.get("upper_bound")
+    if declared_upper is not None:
+        declared_upper = read_int(declared_upper, "upper_bound", 0)
+        if upper is None or declared_upper < upper:
+            raise Refused(f"declared upper bound {declared_upper} is not backed: the verified supporting claims "
+                          f"prove {'no upper bound' if upper is None else f'at most {upper}'}")
+    if claim.get("exact") is not (declared_upper is not None and declared_upper == declared):
+        raise Refused(f"exact is {claim.get('exact')!r} with declared bounds {declared}..{declared_upper}: a count "
+                      "is exact exactly when a proved upper bound meets its lower bound")
     found = claim.get("found")
-    check_found(name, found, bound)
-    extra = f"; {found} found by the library (not certified)" if found is not None else ""
-    extra += check_summary_block(name, claim, bound, summary)
-    facts = {"name": name, "lower_bound": declared, "proved": bound, "found": found}
-    return f"{name} >= {declared} (the {len(used)} verified supporting claims prove >= {bound}){extra}", facts
+    check_found(name, found, bound, upper)
+    extra = f"; {found} found by the library" if found is not None else ""
+    extra += check_summary_block(name, claim, bound, summary, upper)
+    if claim["exact"]:
+        extra = f"; exactly {declared}" + extra
+    facts = {"name": name, "lower_bound": declared, "proved": bound, "upper_bound": declared_upper, "found": found}
+    upper_text = "" if upper is None else f" and <= {upper}"
+    return (f"{name} >= {declared} (the {len(used)} verified supporting claims prove >= {bound}{upper_text})"
+            f"{extra}"), facts

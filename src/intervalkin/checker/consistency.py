@@ -8,13 +8,14 @@ printed, these must hold, and :func:`check_found` refuses the claim otherwise:
 * ``lower_bound <= proved`` (the declared bound is backed; checked in ``claims``);
 * ``found >= proved``: a number of pieces found below a proved minimum is a
   contradiction (the pieces were miscounted, or a proof is wrong), never a
-  result to print.
+  result to print; likewise ``found <= proved upper bound`` when one is proved.
 
 When the certificate folder sits in an output folder (``DIR/certificates``
 beside ``DIR/summary.json``), the summary is what the user read, so
 :func:`check_summary_block` compares each count block with the claim: the same
-``count`` and ``lower_bound``, ``count >= lower_bound``, an ``upper_bound``
-(when one is given) not below them, and ``exact`` only when the two bounds meet.
+``count`` and ``lower_bound``, ``count >= lower_bound``, the claim's ``upper_bound``
+(when one is given: not below them, and backed by what the certificates prove),
+and ``exact`` only when the two bounds meet.
 A summary of a run that did not complete (``"complete": false``) is not
 compared, and the verdict says so.
 
@@ -64,17 +65,22 @@ def _count(v: Any, what: str) -> int:
     return v
 
 
-def check_found(name: str, found: Any, proved: int) -> None:
-    """Refuse a claim whose library count ``found`` is below the lower bound ``proved`` by the verified claims."""
+def check_found(name: str, found: Any, proved: int, proved_upper: int | None = None) -> None:
+    """Refuse a claim whose library count ``found`` is below the lower bound ``proved`` by the verified claims,
+    or above the upper bound ``proved_upper`` they prove (None: none proved)."""
     if found is None:
         return
     found = _count(found, "found")
     if found < proved:
         raise Refused(f"the library found {found} {name.replace('_', ' ')}, below the {proved} that the verified "
                       "claims prove: the count contradicts its certificates")
+    if proved_upper is not None and found > proved_upper:
+        raise Refused(f"the library found {found} {name.replace('_', ' ')}, above the {proved_upper} that the "
+                      "verified claims prove: the count contradicts its certificates")
 
 
-def check_summary_block(name: str, claim: dict, proved: int, summary: dict | None) -> str:
+def check_summary_block(name: str, claim: dict, proved: int, summary: dict | None,
+                        proved_upper: int | None = None) -> str:
     """Compare the ``name`` block of summary.json with its counts claim; the text to add to the verdict.
 
     Raises :class:`Refused` on a contradiction.  Returns "" when there is no
@@ -106,10 +112,14 @@ def check_summary_block(name: str, claim: dict, proved: int, summary: dict | Non
         problems.append(f"count {count} below the {proved} the verified claims prove")
     if upper is not None and (upper < count or upper < proved):
         problems.append(f"upper_bound {upper} below the count {count} or the proved {proved}")
+    if upper != claim.get("upper_bound"):
+        problems.append(f"upper_bound {upper} but the claim declares {claim.get('upper_bound')}")
+    if upper is not None and (proved_upper is None or upper < proved_upper):
+        problems.append(f"upper_bound {upper} is not what the certificates prove ({proved_upper})")
     if exact is not (upper is not None and upper == lower):
         problems.append(f"exact is {exact!r} with bounds {lower}..{upper}")
-    elif exact:
-        problems.append("exact, but the certificates prove no upper bound")
     if problems:
         raise Refused(f"{SUMMARY} contradicts the certificates on {name}: " + "; ".join(problems))
-    return f"; {SUMMARY} agrees (count {count}, lower bound {lower})"
+    bounds = f"lower bound {lower}" + ("" if upper is None else f", upper bound {upper}, exact" if exact
+                                       else f", upper bound {upper}")
+    return f"; {SUMMARY} agrees (count {count}, {bounds})"

@@ -30,7 +30,8 @@ __all__ = ['FORMAT', 'VERSION', 'KINDS', 'INDEX', 'Refused', 'parse_exact',
 FORMAT = "intervalkin-certificate"
 VERSION = 1
 #: Claim files, in the order they are checked (``counts`` last: it uses the others).
-KINDS = ("dkp", "joint_cell", "aspect_distinct", "region_distinct", "box_labels", "trajectory", "counts")
+KINDS = ("dkp", "joint_cell", "aspect_distinct", "region_distinct", "box_labels", "trajectory", "aspect_connected",
+         "counts")
 INDEX = "index.json"
 #: Precisions (bits) accepted in a file.
 PREC_RANGE = (53, 4096)

@@ -1,0 +1,327 @@
+"""The number of aspects, bounded from above: each sign's part of W minus {det A = 0} proved connected.
+
+For a sign s let S_s = {X in W : s det A(X) > 0} (WA1 for s = +1, WA2 for s = -1).
+The aspects are the connected components of S_+ and of S_-, so
+
+    number of aspects = c(S_+) + c(S_-),   c = number of connected components,
+
+and the count is exact (= 2) when both sets are proved nonempty and connected.
+:func:`prove_aspects` builds, for each sign, a COVER of the paving domain by octree
+boxes (integer coordinates, as in :mod:`intervalkin.paving.tree`), each box one of
+
+* OUT: certified free of S_s;
+* SINK: certified inside S_s; the sinks form ONE face-connected set of boxes;
+* RET(e): the retraction condition of :mod:`intervalkin.space.aspect_retraction`
+  holds along e, and every box across an exit face of e is OUT, a SINK, or a RET
+  box of lower rank (the ranks make the chains acyclic);
+* LEFT: none of these could be proved (reported: location and volume).
+
+Lemma (proofs/lemma-aspect-retraction.md): with no LEFT box, every point of S_s is
+joined inside S_s to the sinks, whose union is connected: S_s is connected.  An IN
+box that is not a sink needs no condition of its own (every direction retracts it),
+so small fragments of IN boxes are joined to the sinks through their exit faces:
+the joins of fragments and the absence of hidden pieces come from one argument.
+
+How the cover is built: boxes are split top-down while neither OUT, IN nor
+retractable (up to ``start_depth``); then ranks are computed by a fixed point over
+the face adjacency (a worklist: each rank looks only at the boxes beside those
+resolved at the rank before); clusters of unresolved boxes get one shared direction
+(corners of S_s), and what is still unresolved is split and re-classified, up to
+``max_depth``.  Only the unresolved boxes are refined, so the cover stays small
+(about 20 000 boxes per sign for the paper's manipulator, where the depth-8 paving
+has millions): the independent checker re-proves every box of it in arb.  Cost on
+the paper's manipulator: about 1 s per sign.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.status import Count
+from intervalkin.paving.adjacency import component_labels, shares_face
+from intervalkin.paving.tree import box_bounds, split_boxes, workspace_paving_domain
+from intervalkin.space.aspect_retraction import DIRECTIONS, classify_boxes, exit_faces, shared_direction
+
+__all__ = ["OUT", "SINK", "RET", "LEFT", "AspectCover", "AspectTopology", "face_pairs", "resolve_cover",
+           "cover_aspect", "prove_aspects"]
+
+#: Kinds of the boxes of a cover.
+OUT, SINK, RET, LEFT = 0, 1, 2, 3
+#: Refinement rounds of the unresolved boxes (each one splits them once).
+MAX_ROUNDS = 12
+#: No refinement round that would take a cover past this many boxes (what is unresolved then is reported).
+MAX_BOXES = 200_000
+#: Most groups of sinks a cover may use when one group cannot be reached from everywhere.
+MAX_GROUPS = 8
+
+
+@dataclass(frozen=True, eq=False)
+class AspectCover:
+    """A cover of the paving domain for one sign of det A (module docstring).
+
+    ``level`` (n,), ``ijk`` (n, 3): the boxes; ``kind`` (n,): OUT, SINK, RET or LEFT;
+    ``direction`` (n, 3) int: e = (a, b, c / PHI_DIVISOR) of RET boxes (0 elsewhere);
+    ``rank`` (n,): 0 for OUT and SINK, the step at which a RET box was resolved, -1 for LEFT.
+    ``fragments``: face-connected components of IN boxes (before the joins by retraction).
+    ``groups``: face-connected groups of sinks (each is connected; every point reaches one).
+    ``connected``: no LEFT box and one group of sinks: S_s is proved nonempty and connected.
+    ``empty``: every box is OUT: S_s is proved empty.
+    """
+
+    sign: int
+    domain: np.ndarray
+    level: np.ndarray
+    ijk: np.ndarray
+    kind: np.ndarray
+    direction: np.ndarray
+    rank: np.ndarray
+    fragments: int
+    groups: int
+    seconds: float
+
+    @property
+    def closed(self) -> bool:
+        """No LEFT box: every point of S_s reaches a group of sinks, so S_s has at most ``groups`` components."""
+        return not np.any(self.kind == LEFT)
+
+    @property
+    def components_at_most(self) -> int | None:
+        """The proved upper bound on the number of components of S_s (None: the cover is open)."""
+        return self.groups if self.closed else None
+
+    @property
+    def connected(self) -> bool:
+        return self.closed and self.groups == 1
+
+    @property
+    def empty(self) -> bool:
+        return bool(np.all(self.kind == OUT))
+
+    def boxes(self, mask: np.ndarray | None = None) -> np.ndarray:
+        """Float boxes (m, 3, 2) of the selected cover boxes (all when ``mask`` is None)."""
+        sel = slice(None) if mask is None else mask
+        lo, hi = box_bounds(self.domain, self.level[sel], self.ijk[sel])
+        return np.stack([lo, hi], axis=-1)
+
+    def leftovers(self) -> list[dict]:
+        """The LEFT boxes: where the proof did not close (box bounds and volume)."""
+        b = self.boxes(self.kind == LEFT)
+        return [{"box": bb.tolist(), "volume": float(np.prod(bb[:, 1] - bb[:, 0]))} for bb in b]
+
+    def to_json(self) -> dict:
+        kinds = {name: int(np.count_nonzero(self.kind == v)) for name, v in
+                 (("out", OUT), ("sink", SINK), ("retract", RET), ("left", LEFT))}
+        return {"sign": self.sign, "boxes": int(len(self.level)), "kinds": kinds, "inside_fragments": self.fragments,
+                "sink_groups": self.groups, "components_at_most": self.components_at_most, "connected": self.connected, "empty": self.empty, "deepest_level": int(self.level.max()),
+                "longest_chain": int(self.rank.max()), "seconds": round(self.seconds, 3),
+                "leftovers": self.leftovers()[:20]}
+
+
+@dataclass(frozen=True, eq=False)
+class AspectTopology:
+    """Both covers and the upper bound they prove on the number of aspects (None: not proved)."""
+
+    covers: tuple[AspectCover, ...]
+
+    @property
+    def upper(self) -> int | None:
+        """Sum over the signs of the proved bound on their components; None when a cover is open."""
+        bounds = [c.components_at_most for c in self.covers]
+        return None if any(b is None for b in bounds) else sum(bounds)
+
+    @property
+    def seconds(self) -> float:
+        return sum(c.seconds for c in self.covers)
+
+    def count(self, found: Count) -> Count:
+        """The aspect count ``found`` (its lower bound from opposite signs) with this upper bound added."""
+        upper = self.upper
+        if upper is None or upper < found.found:
+            left = sum(len(c.leftovers()) for c in self.covers)
+            return Count(found.found, found.lower, None, False, found.why + f"; the covers of the two signs leave "
+                         f"{left} boxes undecided (listed under \"covers\"), so no upper bound is proved")
+        groups = " + ".join(str(c.groups) for c in self.covers)
+        return Count(found.found, found.lower, upper, upper == found.lower,
+                     f"at least {found.lower}: opposite certified signs of det A; at most {upper} = {groups}: for each "
+                     "sign, a cover of the domain by boxes free of it, inside it (face-connected groups of sinks) or "
+                     "retracting onto the sinks along certified monotone directions proves that its part of W has at "
+                     "most one component per group (proofs/lemma-aspect-retraction.md)")
+
+    def to_json(self) -> dict:
+        return {"upper_bound": self.upper, "covers": {("WA1" if c.sign > 0 else "WA2"): c.to_json()
+                                                      for c in self.covers}}
+
+
+def face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Directed face adjacency of a tiling: (pairs (3, m): box, neighbour, face), on_border (n, 6), edges.
+
+    Row (a, b, f): b lies across face f of a (face 2k: -axis-k side, 2k + 1: + side; phi wraps).
+    ``on_border[a, f]``: face f of a lies on the x or y border of the domain (no neighbour there).
+    ``edges`` is :func:`~intervalkin.paving.adjacency.shares_face` of the boxes.
+    """
+    level = np.asarray(level, dtype=np.int64)
+    edges = shares_face(level, ijk, depth)
+    shift = (depth - level)[:, None]
+    lo, hi = ijk << shift, (ijk + 1) << shift
+    nfine = np.int64(1) << depth
+    a, b = edges
+    rows = []
+    for ax in range(3):
+        others = [o for o in range(3) if o != ax]
+        overlap = np.all(np.minimum(hi[a][:, others], hi[b][:, others]) > np.maximum(lo[a][:, others],
+                                                                                     lo[b][:, others]), axis=1)
+        wrap = nfine if ax == 2 else np.int64(1) << 62
+        for p, q in ((a, b), (b, a)):
+            m = overlap & ((hi[p, ax] % wrap) == (lo[q, ax] % wrap))  # q across the + face of p
+            rows.append(np.stack([p[m], q[m], np.full(int(m.sum()), 2 * ax + 1)]))
+            rows.append(np.stack([q[m], p[m], np.full(int(m.sum()), 2 * ax)]))
+    pairs = np.concatenate(rows, axis=1)
+    border = np.zeros((len(level), 6), dtype=bool)
+    for ax in range(2):
+        border[:, 2 * ax] = lo[:, ax] == 0
+        border[:, 2 * ax + 1] = hi[:, ax] == nfine
+    return pairs, border, edges
+
+
+def resolve_cover(level, ijk, depth, out, inside, ok, custom_faces, volume, max_groups: int = 1):
+    """Sinks, ranks and chosen candidates of the boxes of one cover (numpy fixed point).
+
+    The sinks are the face-connected component of IN boxes of largest volume; other IN boxes
+    take any fixed direction.  When the fixed point stalls with IN boxes unresolved and fewer than
+    ``max_groups`` sink groups, the largest unresolved fragment of IN boxes becomes one more group
+    (each group is connected; the set is then proved to have at most that many components).
+    Returns (kind, rank, choice, fragments, edges, groups); ``choice`` indexes the candidate
+    directions (-1: none), LEFT boxes are those no rank reached, ``edges`` the face adjacency.
+    """
+    n = len(level)
+    pairs, border, edges = face_pairs(level, ijk, depth)
+    comp = component_labels(n, edges, inside)
+    fragments = int(comp.max()) + 1 if np.any(inside) else 0
+    frag_vol = np.bincount(comp[inside], weights=volume[inside], minlength=fragments)
+    sink = np.zeros(n, dtype=bool)
+    groups = 0
+    ok = ok.copy()
+    ok[inside, :len(DIRECTIONS)] = True  # the fixed directions only (a per-box one may be 0)
+    fixed_faces = exit_faces(DIRECTIONS).astype(np.uint8).T  # (6, m)
+    resolved = out.copy()
+    rank = np.where(resolved, 0, -1)
+    choice = np.full(n, -1, dtype=np.int64)
+    # opened[a, f]: neighbours across face f of a not resolved yet (a worklist: only boxes next to the
+    # boxes resolved at the last step can change)
+    opened = np.zeros((n, 6), dtype=np.int64)
+    nb = ~resolved[pairs[1]]
+    np.add.at(opened, (pairs[0][nb], pairs[2][nb]), 1)
+    new = np.zeros(0, dtype=np.int64)
+    step = 0
+    while True:
+        if new.size == 0:  # stalled (or starting): one more sink group, if allowed and any IN box is left
+            left_in = inside & ~resolved
+            if groups >= max_groups or not np.any(left_in):
+                break
+            vols = np.where(np.bincount(comp[left_in], minlength=fragments) > 0, frag_vol, -1.0)
+            new = np.flatnonzero(comp == int(np.argmax(vols)))
+            sink[new] = True
+            rank[new] = 0
+            groups += 1
+        else:
+            step += 1
+            rank[new] = step
+        resolved[new] = True
+        now = np.zeros(n, dtype=bool)
+        now[new] = True
+        sel = now[pairs[1]]
+        np.subtract.at(opened, (pairs[0][sel], pairs[2][sel]), 1)
+        touched = np.flatnonzero(~resolved) if groups == 1 and step == 0 else np.unique(pairs[0][sel])
+        frontier = touched[~resolved[touched]]
+        bad = border[frontier] | (opened[frontier] > 0)
+        blocked = np.concatenate([(bad.astype(np.uint8) @ fixed_faces) > 0,
+                                  np.any(custom_faces[frontier] & bad[:, None, :], axis=-1)], axis=1)
+        good = ok[frontier] & ~blocked
+        hit = np.any(good, axis=1)
+        new = frontier[hit]
+        choice[new] = np.argmax(good[hit], axis=1)
+    kind = np.full(n, LEFT, dtype=np.uint8)
+    kind[out] = OUT
+    kind[sink] = SINK
+    kind[(rank > 0)] = RET
+    return kind, rank, choice, fragments, edges, groups
+
+
+def _classified(geometry, domain, level, ijk, sign):
+    """Labels of boxes given by integer coordinates, with room for a third per-box direction (shared)."""
+    lo, hi = box_bounds(domain, level, ijk)
+    c = classify_boxes(geometry, np.stack([lo, hi], axis=-1), sign)
+    n = len(level)
+    ok = np.concatenate([c.ok, np.zeros((n, 1), dtype=bool)], axis=1)
+    custom = np.concatenate([c.custom, np.zeros((n, 1, 3), dtype=np.int64)], axis=1)
+    return [c.out, c.inside, ok, custom, np.prod(hi - lo, axis=1)]
+
+
+def _share_directions(geometry, domain, level, ijk, kind, edges, sign, ok, custom) -> None:
+    """Give each face-connected cluster of LEFT boxes one shared direction where it is certified (in place)."""
+    left = kind == LEFT
+    comp = component_labels(len(level), edges, left)
+    for c in range(int(comp.max()) + 1 if np.any(left) else 0):
+        rows = np.flatnonzero(comp == c)
+        lo, hi = box_bounds(domain, level[rows], ijk[rows])
+        e, good = shared_direction(geometry, np.stack([lo, hi], axis=-1), sign)
+        custom[rows[good], 2] = e
+        ok[rows[good], -1] = True
+
+
+def cover_aspect(geometry: Geometry, sign: int, start_depth: int = 9, max_depth: int = 12) -> AspectCover:
+    """The cover of S_sign (module docstring): split top-down to ``start_depth``, then refine the unresolved.
+
+    Each round resolves the cover; clusters of unresolved boxes are given a shared direction and
+    the cover is resolved again; what is still unresolved is split (up to ``max_depth``).
+    """
+    t0 = time.perf_counter()
+    domain = workspace_paving_domain(geometry)
+    level = np.zeros(1, dtype=np.int64)
+    ijk = np.zeros((1, 3), dtype=np.int64)
+    parts = []
+    for lev in range(start_depth + 1):  # top-down: split what is neither OUT, IN nor retractable
+        lab = _classified(geometry, domain, level, ijk, sign)
+        out, inside, ok = lab[:3]
+        cut = ~out & ~inside & ~np.any(ok, axis=1) & (lev < start_depth)
+        parts.append([level[~cut], ijk[~cut]] + [a[~cut] for a in lab])
+        if not np.any(cut):
+            break
+        level, ijk = split_boxes(level[cut], ijk[cut])
+    level, ijk, out, inside, ok, custom, vol = (np.concatenate(p) for p in zip(*parts))
+    for rnd in range(MAX_ROUNDS + 1):
+        depth = max(int(level.max()), 1)
+        faces = exit_faces(custom)
+        kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, depth, out, inside, ok, faces, vol)
+        if np.any(kind == LEFT):
+            _share_directions(geometry, domain, level, ijk, kind, edges, sign, ok, custom)
+            faces = exit_faces(custom)
+            kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, depth, out, inside, ok,
+                                                                         faces, vol)
+        cut = (kind == LEFT) & (level < max_depth)
+        if rnd == MAX_ROUNDS or not np.any(cut) or len(level) + 7 * int(cut.sum()) > MAX_BOXES:
+            if np.any(kind == LEFT):  # what one group of sinks cannot reach: more groups (a weaker bound)
+                kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, depth, out, inside, ok,
+                                                                             faces, vol, MAX_GROUPS)
+            break
+        cl, cijk = split_boxes(level[cut], ijk[cut])
+        lab = _classified(geometry, domain, cl, cijk, sign)
+        keep = ~cut
+        level, ijk = np.concatenate([level[keep], cl]), np.concatenate([ijk[keep], cijk])
+        out, inside, ok, custom, vol = (np.concatenate([a[keep], b]) for a, b in zip((out, inside, ok, custom, vol), lab))
+    direction = np.zeros((len(level), 3), dtype=np.int64)
+    rows = np.flatnonzero(kind == RET)
+    j = choice[rows]
+    m = len(DIRECTIONS)
+    direction[rows] = np.where((j < m)[:, None], DIRECTIONS[np.minimum(j, m - 1)], custom[rows, np.clip(j - m, 0, 2)])
+    return AspectCover(sign, domain, level.astype(np.int64), ijk, kind, direction, rank, fragments, groups,
+                       time.perf_counter() - t0)
+
+
+def prove_aspects(geometry: Geometry, start_depth: int = 9, max_depth: int = 12) -> AspectTopology:
+    """Covers of WA1 (det A > 0) and WA2 (det A < 0); :attr:`AspectTopology.upper` is the proved bound."""
+    return AspectTopology(tuple(cover_aspect(geometry, s, start_depth, max_depth) for s in (1, -1)))

@@ -1,0 +1,158 @@
+"""The independent checker on ``aspect_connected`` claims: the real claims verify, falsified ones are refused.
+
+Each tampering is one a faulty library could produce: a retraction along the wrong direction,
+a box called a sink (a false join of fragments), a retracting box listed before the boxes it
+retracts onto (a cycle), a box left out (a hole where a piece of an aspect could hide), a
+domain too small, and counts declared exact without the covers.  The arb proofs run box by
+box after the cheap combinatorial steps, so the tamperings are placed where they fail fast.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+from flint import arb, ctx
+
+from intervalkin.certify.aspect_claims import aspect_connected_claims
+from intervalkin.checker import check_claim
+from intervalkin.checker.aspects import _box, retracts
+from intervalkin.checker.labels import holds_on_box
+from intervalkin.checker.claims import check_count, count_upper
+from intervalkin.checker.model import ArbModel, balls
+from intervalkin.checker.parse import Refused
+from intervalkin.checker.taylor import HyperDual, slope_enclosure, value_enclosure
+from intervalkin.space.aspect_retraction import classify_boxes
+from intervalkin.space.aspect_topology import SINK, face_pairs
+
+
+@pytest.fixture(scope="module")
+def claims(aspect_topology):
+    got, omitted = aspect_connected_claims(aspect_topology)
+    assert not omitted and [c["id"] for c in got] == ["WA1", "WA2"]
+    return got
+
+
+def _refused(geometry, claim) -> str:
+    ok, why = check_claim(geometry, "aspect_connected", claim)
+    assert not ok
+    return why
+
+
+def test_the_claims_of_the_paper_verify(paper_geometry, claims):
+    for claim in claims:
+        ok, why = check_claim(paper_geometry, "aspect_connected", claim)
+        assert ok, why
+        assert "nonempty and connected" in why
+
+
+def _first_ret(claim) -> int:
+    return next(k for k, row in enumerate(claim["boxes"]) if row[4] >= 0)
+
+
+def test_a_false_retraction_is_refused(paper_geometry, claims):
+    """The last retracting row (highest rank: nothing retracts onto it, and every box is listed before it)
+    given the reverse of its direction: only the arb step can refuse it, and it does."""
+    claim = copy.deepcopy(claims[0])
+    model = ArbModel(paper_geometry)
+    domain = [[float.fromhex(lo), float.fromhex(hi)] for lo, hi in claim["domain"]]
+    row = next(r for r in reversed(claim["boxes"]) if r[4] >= 0 and not _retracts_reversed(model, domain, claim, r))
+    a, b, c = claim["directions"][row[4]]
+    claim["directions"].append([-a, -b, -c])
+    row[4] = len(claim["directions"]) - 1
+    claim["boxes"].remove(row)
+    claim["boxes"].append(row)
+    assert "not proved retracting" in _refused(paper_geometry, claim)
+
+
+def _retracts_reversed(model, domain, claim, row) -> bool:
+    a, b, c = claim["directions"][row[4]]
+    with ctx.workprec(128):
+        e = [arb(-a), arb(-b), arb(-c) / claim["phi_divisor"]]
+        return retracts(model, _box(domain, tuple(row[:4])), 1, e)
+
+
+def test_reversed_directions_fail_in_arb(paper_geometry, claims):
+    """The arb test itself: on many RET boxes the reversed direction is refused (would catch a slope whose
+    sign is ignored), while the stated one passes on sub-boxes covering the box."""
+    claim = claims[0]
+    model = ArbModel(paper_geometry)
+    domain = [[float.fromhex(lo), float.fromhex(hi)] for lo, hi in claim["domain"]]
+    rows = [r for r in claim["boxes"] if r[4] >= 0][:300]
+    refused = sum(not _retracts_reversed(model, domain, claim, r) for r in rows)
+    assert refused > 100
+    with ctx.workprec(128):
+        for r in rows[:40]:
+            a, b, c = claim["directions"][r[4]]
+            e = [arb(a), arb(b), arb(c) / claim["phi_divisor"]]
+            assert holds_on_box(_box(domain, tuple(r[:4])), lambda s: retracts(model, s, 1, e))
+
+
+def test_a_false_join_is_refused(paper_geometry, claims, aspect_topology):
+    """A box beside the sinks but not inside the aspect declared a sink (a join through a place outside
+    the aspect, or through its undecided layer), listed first."""
+    cover = aspect_topology.covers[0]
+    pairs, _, _ = face_pairs(cover.level, cover.ijk, int(cover.level.max()))
+    near = pairs[1][(cover.kind[pairs[0]] == SINK) & (cover.kind[pairs[1]] != SINK)]
+    c = classify_boxes(paper_geometry, cover.boxes(np.isin(np.arange(len(cover.kind)), near)), 1)
+    target = np.unique(near)[~c.inside][0]
+    key = [int(cover.level[target])] + cover.ijk[target].tolist()
+    claim = copy.deepcopy(claims[0])
+    row = next(r for r in claim["boxes"] if r[:4] == key)
+    claim["boxes"].remove(row)
+    claim["boxes"].insert(0, key + [-2])
+    assert "not proved inside WA1" in _refused(paper_geometry, claim)
+
+
+def test_a_cycle_a_hole_and_a_small_domain_are_refused(paper_geometry, claims):
+    """The highest-rank row moved before the first retracting row: a box it retracts onto now comes after
+    it (the order no longer makes the chains acyclic).  A row left out: the boxes no longer tile the
+    domain.  A domain cut short: W may leave it."""
+    claim = copy.deepcopy(claims[1])
+    rows = claim["boxes"]
+    rows.insert(_first_ret(claim), rows.pop())
+    assert "neither OUT, a sink nor an earlier" in _refused(paper_geometry, claim)
+    hole = copy.deepcopy(claims[1])
+    hole["boxes"].pop(3)
+    assert "do not tile" in _refused(paper_geometry, hole)
+    small = copy.deepcopy(claims[1])
+    small["domain"][0][1] = (float.fromhex(small["domain"][0][1]) - 1).hex()
+    assert "A1 -+ rho_max_1" in _refused(paper_geometry, small)
+
+
+def test_counts_exact_only_with_both_signs_connected():
+    """count_upper needs a verified cover for each sign; exact needs the declared bounds to meet."""
+    both = [{"signs": {1, -1}}, {"aspect_sign": 1, "components_at_most": 1}, {"aspect_sign": -1, "components_at_most": 1}]
+    assert count_upper("aspects", both) == 2
+    assert count_upper("aspects", both[:2]) is None
+    assert count_upper("basic_regions", both) is None
+    verified = {f"f#{k}": f for k, f in enumerate(both)}
+    claim = {"name": "aspects", "lower_bound": 2, "upper_bound": 2, "found": 2, "exact": True,
+             "support": list(verified)}
+    msg, facts = check_count(claim, verified)
+    assert "exactly 2" in msg and facts["upper_bound"] == 2
+    with pytest.raises(Refused, match="not backed"):
+        check_count(claim, {k: v for k, v in verified.items() if k != "f#2"})
+    with pytest.raises(Refused, match="exact is False"):
+        check_count({**claim, "exact": False}, verified)
+    with pytest.raises(Refused, match="above the 2"):
+        check_count({**claim, "found": 3}, verified)
+
+
+def test_taylor_forms_enclose_and_tighten(paper_geometry):
+    """The Taylor forms contain the values (and slopes) at sampled points of the box, and the value form is
+    much narrower than the natural one on this box of level 7 (where the natural one has no sign)."""
+    model = ArbModel(paper_geometry)
+    b = ((11.5, 12.0), (-20.0, -19.5), (0.8344855486097891, 0.8835729338221294))
+    with ctx.workprec(128):
+        box = balls(b)
+        v = value_enclosure(model.det, box)
+        assert v.rad() < model.det(*box).rad() / 2
+        e = [arb(16), arb(0), arb(1) / 16]
+        s = slope_enclosure(model.det, box, e)
+        for t in (0.0, 0.3, 0.7, 1.0):
+            p = [arb(lo + t * (hi - lo)) for lo, hi in b]
+            assert v.overlaps(model.det(*p))
+            at = model.det(*[HyperDual(q, d, arb(0), arb(0)) for q, d in zip(p, e)])
+            assert s.overlaps(at.a)

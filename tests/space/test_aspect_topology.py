@@ -1,0 +1,110 @@
+"""Covers of the aspects: tiling, ranks, and the exact count of 2 on the paper's manipulator."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from intervalkin.core.status import Count, Status
+from intervalkin.paving.adjacency import component_labels, shares_face
+from intervalkin.space.aspect_retraction import DIRECTIONS, exit_faces
+from intervalkin.space.aspect_topology import LEFT, OUT, RET, SINK, AspectTopology, face_pairs, resolve_cover
+
+
+def test_the_paper_has_exactly_two_aspects(aspect_topology):
+    """Both signs close: no LEFT box, sinks present; the count becomes exact."""
+    assert aspect_topology.upper == 2
+    for cover in aspect_topology.covers:
+        assert cover.connected and not cover.empty and not cover.leftovers()
+        assert cover.fragments > 1  # the IN boxes alone are fragmented: the retractions join them
+    found = Count(2, 2, None, False, "signs")
+    c = aspect_topology.count(found)
+    assert (c.found, c.lower, c.upper, c.exact, c.status) == (2, 2, 2, True, Status.CERTIFIED)
+
+
+def test_each_cover_tiles_the_domain(aspect_topology):
+    """Integer volumes add up to the domain and no two boxes overlap (the checker's rule, in numpy)."""
+    for cover in aspect_topology.covers:
+        depth = int(cover.level.max())
+        assert int(np.sum(8 ** (depth - cover.level.astype(np.int64)))) == 8 ** depth
+        fine = cover.ijk << (depth - cover.level)[:, None]
+        keys = set(map(tuple, np.column_stack([cover.level, cover.ijk]).tolist()))
+        assert len(keys) == len(cover.level)
+        for lev, i, j, k in list(keys)[:3000]:
+            assert not any((lev - u, i >> u, j >> u, k >> u) in keys for u in range(1, lev + 1))
+        assert fine.min() >= 0
+
+
+def test_ranks_point_downhill_and_sinks_are_one_component(aspect_topology):
+    """Every box across an exit face of a RET box is OUT, a sink, or of lower rank; the sinks are one set."""
+    for cover in aspect_topology.covers:
+        depth = int(cover.level.max())
+        pairs, border, edges = face_pairs(cover.level, cover.ijk, depth)
+        ret = cover.kind == RET
+        faces = exit_faces(cover.direction)
+        a, b, f = pairs
+        sel = ret[a] & faces[a, f]
+        ok = (cover.kind[b[sel]] == OUT) | (cover.kind[b[sel]] == SINK) | \
+             ((cover.kind[b[sel]] == RET) & (cover.rank[b[sel]] < cover.rank[a[sel]]))
+        assert np.all(ok)
+        assert not np.any(border[ret] & faces[ret])
+        sinks = component_labels(len(cover.level), edges, cover.kind == SINK)
+        assert sinks.max() == 0
+        assert np.all(np.any(cover.direction[ret] != 0, axis=1))
+
+
+def test_face_pairs_agree_with_the_face_adjacency():
+    """Every face-adjacent pair appears once from each side, across opposite faces (phi seam included)."""
+    level = np.array([1, 1, 1, 1, 2, 2, 2, 2, 1, 1, 1, 1], dtype=np.int64)
+    ijk = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 0], [0, 1, 1], [2, 0, 0], [3, 0, 0], [2, 1, 0], [3, 1, 0],
+                    [1, 0, 1], [1, 1, 0], [1, 1, 1], [1, 0, 0]])
+    keep = level == 1
+    keep[4:8] = True
+    keep[11] = False  # [1, 0, 0] at level 1 is covered by the four level-2 boxes
+    level, ijk = level[keep], ijk[keep]
+    # complete the tiling: the level-2 boxes cover x in [1/2, 1], y in [0, 1/2], phi in [0, 1/4]
+    extra = np.array([[2, 0, 1], [3, 0, 1], [2, 1, 1], [3, 1, 1]])
+    level, ijk = np.concatenate([level, [2] * 4]), np.concatenate([ijk, extra])
+    assert int(np.sum(8 ** (2 - level))) == 64
+    pairs, border, edges = face_pairs(level, ijk, 2)
+    und = {tuple(sorted(p)) for p in pairs[:2].T.tolist()}
+    assert und == set(map(tuple, shares_face(level, ijk, 2).T.tolist()))
+    opposite = {(a, b, f) for a, b, f in pairs.T.tolist()}
+    assert all((b, a, f ^ 1) in opposite for a, b, f in opposite)
+
+
+def test_an_open_cover_gives_no_upper_bound(aspect_topology):
+    """A LEFT box anywhere: no upper bound, the count stays a lower bound and says where it is open."""
+    cover = aspect_topology.covers[1]
+    kind = cover.kind.copy()
+    kind[np.flatnonzero(kind == RET)[0]] = LEFT
+    import dataclasses
+    broken = AspectTopology((aspect_topology.covers[0], dataclasses.replace(cover, kind=kind)))
+    assert broken.upper is None
+    c = broken.count(Count(2, 2, None, False, "signs"))
+    assert c.upper is None and not c.exact and "1 boxes undecided" in c.why
+    assert len(broken.covers[1].leftovers()) == 1
+
+
+def test_directions_are_integer_and_nonzero():
+    assert DIRECTIONS.dtype.kind == "i" and np.all(np.any(DIRECTIONS != 0, axis=1))
+    assert len({tuple(d) for d in DIRECTIONS.tolist()}) == len(DIRECTIONS)
+
+
+def test_a_fragment_no_chain_reaches_becomes_another_group_of_sinks():
+    """Two IN boxes separated by boxes that retract nowhere: with one group the second stays LEFT; with two
+    groups allowed it becomes a second group of sinks (the bound is then 2 for this sign, not 1)."""
+    level = np.full(64, 2, dtype=np.int64)
+    ijk = np.array([[i, j, k] for i in range(4) for j in range(4) for k in range(4)], dtype=np.int64)
+    out = np.zeros(64, dtype=bool)
+    inside = np.zeros(64, dtype=bool)
+    first, second = 0, 2 * 16  # (0, 0, 0) and (2, 0, 0)
+    inside[[first, second]] = True
+    ok = np.zeros((64, len(DIRECTIONS) + 3), dtype=bool)
+    faces = np.zeros((64, 3, 6), dtype=bool)
+    vol = np.ones(64)
+    kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, 2, out, inside, ok, faces, vol)
+    assert fragments == 2 and groups == 1
+    assert sorted(kind[[first, second]].tolist()) == [SINK, LEFT]
+    kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, 2, out, inside, ok, faces, vol, 2)
+    assert groups == 2 and kind[first] == kind[second] == SINK
+    assert np.all(kind[~inside] == LEFT)
