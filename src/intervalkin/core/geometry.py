@@ -277,21 +277,25 @@ def parse_geometry(doc: dict, source: str = "geometry") -> Geometry:
     )
 
 
-def load_geometry(path: str | Path) -> Geometry:
-    """Read and validate a geometry TOML file (numbers read as exact decimals)."""
+def read_toml(path: str | Path, what: str, error: type[Exception] = GeometryError) -> dict:
+    """The TOML document of a file, numbers as exact decimals; ``error`` with one line naming ``what`` and the problem."""
     p = Path(path)
     try:
         with p.open("rb") as f:
-            doc = tomllib.load(f, parse_float=decimal.Decimal)
+            return tomllib.load(f, parse_float=decimal.Decimal)
     except FileNotFoundError:
-        raise GeometryError(f"geometry file {str(p)!r}: not found") from None
+        raise error(f"{what} {str(p)!r}: not found") from None
     except IsADirectoryError:
-        raise GeometryError(f"geometry file {str(p)!r}: is a directory") from None
+        raise error(f"{what} {str(p)!r}: is a directory") from None
     except tomllib.TOMLDecodeError as exc:
-        raise GeometryError(f"geometry file {str(p)!r}: malformed TOML ({exc})") from None
+        raise error(f"{what} {str(p)!r}: malformed TOML ({exc})") from None
     except (OSError, UnicodeDecodeError) as exc:
-        raise GeometryError(f"geometry file {str(p)!r}: cannot read ({exc})") from None
-    return parse_geometry(doc, source=str(p))
+        raise error(f"{what} {str(p)!r}: cannot read ({exc})") from None
+
+
+def load_geometry(path: str | Path) -> Geometry:
+    """Read and validate a geometry TOML file (numbers read as exact decimals)."""
+    return parse_geometry(read_toml(path, "geometry file"), source=str(Path(path)))
 
 
 def default_geometry() -> Geometry:

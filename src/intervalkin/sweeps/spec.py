@@ -35,7 +35,6 @@ decimals, as fractions, not the name), the analysis settings and the intervalkin
 from __future__ import annotations
 
 import copy
-import decimal
 import hashlib
 import itertools
 import json
@@ -48,7 +47,7 @@ from typing import Any, Mapping
 import tomllib
 
 from intervalkin.core.errors import GeometryError, InputError
-from intervalkin.core.geometry import Geometry, parse_geometry
+from intervalkin.core.geometry import Geometry, parse_geometry, read_toml
 from intervalkin.core.version import __version__
 
 __all__ = ["SweepFileError", "Settings", "Design", "SweepSpec", "CRITERIA_DEFAULT", "MAX_DESIGNS",
@@ -327,15 +326,5 @@ def parse_sweep(doc: Mapping, source: str = "sweep", folder: str | Path = ".") -
 def load_sweep(path: str | Path) -> SweepSpec:
     """Read and validate a sweep file; a geometry file it names is read relative to it."""
     p = Path(path)
-    try:
-        with p.open("rb") as f:
-            doc = tomllib.load(f, parse_float=decimal.Decimal)
-    except FileNotFoundError:
-        raise SweepFileError(f"sweep file {str(p)!r}: not found") from None
-    except IsADirectoryError:
-        raise SweepFileError(f"sweep file {str(p)!r}: is a directory") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SweepFileError(f"sweep file {str(p)!r}: malformed TOML ({exc})") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SweepFileError(f"sweep file {str(p)!r}: cannot read ({exc})") from None
+    doc = read_toml(p, "sweep file", SweepFileError)
     return parse_sweep(doc, source=str(p), folder=p.parent)
