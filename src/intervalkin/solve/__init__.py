@@ -1,4 +1,4 @@
-"""solve/: certified direct kinematics of the 3-RPR, and continuation along joint-space paths.
+"""solve/: certified direct kinematics of the 3-RPR, joint boxes proved off g(S) or cut by one fold sheet, continuation.
 
 The layer is callable: ``intervalkin.solve(rho, geometry=None)`` solves the
 direct kinematics of one joint vector (:func:`solve_joint_vector`).  A package
