@@ -20,18 +20,11 @@ import tomllib
 
 import intervalkin
 from intervalkin.sweeps.spec import parse_sweep
+from tests.sweeps.shared import GRID
 
 distributed = pytest.importorskip("distributed")
 dask = pytest.importorskip("dask")
 
-GRID = """
-name = "scale x rho_max"
-[analysis]
-depth = 4
-[vary]
-"platform.scale" = { start = 0.8, stop = 1.2, step = 0.2 }
-"limits.rho_max" = [28, 30, 32, 36]
-"""
 
 
 def _spec(text: str):

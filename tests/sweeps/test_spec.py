@@ -9,15 +9,8 @@ import tomllib
 
 from intervalkin.core.geometry import default_geometry
 from intervalkin.sweeps.spec import Settings, SweepFileError, design_key, load_sweep, parse_sweep
+from tests.sweeps.shared import GRID
 
-GRID = """
-name = "grid"
-[analysis]
-depth = 4
-[vary]
-"platform.scale" = { start = 0.8, stop = 1.2, step = 0.2 }
-"limits.rho_max" = [28, 30, 32, 36]
-"""
 
 
 def _doc(text: str) -> dict:

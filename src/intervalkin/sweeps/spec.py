@@ -232,15 +232,21 @@ def design_key(geometry: Geometry, settings: Settings) -> str:
     return hashlib.sha256(json.dumps(doc, sort_keys=True).encode()).hexdigest()
 
 
+def _table(doc: dict, name: str, allowed: tuple[str, ...]) -> dict:
+    """The optional table ``name`` of the sweep file, refused when it is not a table or has another key."""
+    table = doc.get(name, {})
+    if not isinstance(table, dict):
+        raise SweepFileError(f"{name}: expected a table, got {table!r}")
+    extra = set(table) - set(allowed)
+    if extra:
+        raise SweepFileError(f"{name}.{sorted(extra)[0]}: unknown key (allowed: {', '.join(allowed)})")
+    return table
+
+
 def _settings(doc: dict) -> Settings:
     from intervalkin.pipeline import MAX_CHAIN_DEPTH  # light: the pipeline module is loaded by every run anyway
 
-    table = doc.get("analysis", {})
-    if not isinstance(table, dict):
-        raise SweepFileError(f"analysis: expected a table, got {table!r}")
-    extra = set(table) - {"depth", "refine_to"}
-    if extra:
-        raise SweepFileError(f"analysis.{sorted(extra)[0]}: unknown key (allowed: depth, refine_to)")
+    table = _table(doc, "analysis", ("depth", "refine_to"))
     depth = table.get("depth", 5)
     if isinstance(depth, bool) or not isinstance(depth, int) or not 3 <= depth <= MAX_CHAIN_DEPTH:
         raise SweepFileError(f"analysis.depth: expected an integer in 3..{MAX_CHAIN_DEPTH}, got {depth!r}")
@@ -254,12 +260,7 @@ def _settings(doc: dict) -> Settings:
 def _best(doc: dict) -> tuple[str, str]:
     from intervalkin.sweeps.table import NUMERIC_COLUMNS
 
-    table = doc.get("best", {})
-    if not isinstance(table, dict):
-        raise SweepFileError(f"best: expected a table, got {table!r}")
-    extra = set(table) - {"by", "order"}
-    if extra:
-        raise SweepFileError(f"best.{sorted(extra)[0]}: unknown key (allowed: by, order)")
+    table = _table(doc, "best", ("by", "order"))
     by, order = table.get("by", CRITERIA_DEFAULT), table.get("order", "max")
     if by not in NUMERIC_COLUMNS:
         raise SweepFileError(f"best.by: expected a numeric column of the table "
