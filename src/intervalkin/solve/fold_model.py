@@ -54,7 +54,9 @@ from intervalkin.kinematics.enclosures import (det_a_gradient_interval, det_a_in
 
 __all__ = ["FoldModels", "fold_models", "side_of", "pose_hulls"]
 
-#: Epsilon-inflation rounds of the Krawczyk box before a model is given up.
+#: Krawczyk rounds before a box is given up: the first shrink the pose box to its intersection with
+#: the images, the last INFLATE_ROUNDS grow it to the hull of the box and the images (plus a margin).
+ROUNDS = 6
 INFLATE_ROUNDS = 2
 #: Krawczyk steps of the side test (each one shrinks the enclosure of X*(q) by about the norm of C).
 SIDE_STEPS = 4
@@ -72,6 +74,7 @@ class FoldModels:
     height : Interval (n,), an enclosure of h = rho_k(X*(p)) over all p.
     inv : (n, 3, 3) the float preconditioner Y of the proof (reused by the side test).
     contraction : Interval (n, 3, 3), C = I - Y E'(X) over the pose box (reused by the side test).
+    void : (n,) bool, the box is proved to hold no singular pose (clear; ``ok`` is False there).
     """
 
     ok: np.ndarray
@@ -80,6 +83,7 @@ class FoldModels:
     height: Interval
     inv: np.ndarray
     contraction: Interval
+    void: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.ok)
@@ -87,7 +91,7 @@ class FoldModels:
     def take(self, rows: np.ndarray) -> "FoldModels":
         """The models of the given rows, in that order."""
         return FoldModels(self.ok[rows], self.axis[rows], self.pose[rows], self.height[rows], self.inv[rows],
-                          self.contraction[rows])
+                          self.contraction[rows], None if self.void is None else self.void[rows])
 
     def concat(self, other: "FoldModels") -> "FoldModels":
         def cat(a, b):
@@ -96,11 +100,14 @@ class FoldModels:
                           Interval(cat(self.height.lo, other.height.lo), cat(self.height.hi, other.height.hi)),
                           cat(self.inv, other.inv),
                           Interval(cat(self.contraction.lo, other.contraction.lo),
-                                   cat(self.contraction.hi, other.contraction.hi)))
+                                   cat(self.contraction.hi, other.contraction.hi)),
+                          None if self.void is None or other.void is None else cat(self.void, other.void))
 
 
 def pose_hulls(geometry: Geometry, joint_boxes: np.ndarray, owner: np.ndarray, cells: np.ndarray):
     """Per joint box, the hull of the pose boxes of its live torus cells: (n, 3, 2), NaN where none.
+
+    ``owner`` must be sorted (the cells of one box form one run).
 
     A cluster that straddles the phi seam is shifted by 2 pi (every quantity is
     2 pi-periodic in phi), so the hull stays narrow where it can.
@@ -109,6 +116,8 @@ def pose_hulls(geometry: Geometry, joint_boxes: np.ndarray, owner: np.ndarray, c
     out = np.full((n, 3, 2), np.nan)
     if owner.size == 0:
         return out
+    if np.any(np.diff(owner) < 0):
+        raise ValueError("pose_hulls: the cells must be sorted by owner")
     k = constants(geometry)
     r1 = Interval(joint_boxes[owner, 0, 0], joint_boxes[owner, 0, 1])
     th = Interval(cells[:, 0], cells[:, 1])
@@ -217,15 +226,20 @@ def _normal_signs(geometry: Geometry, K: np.ndarray) -> np.ndarray:
     return out
 
 
-def fold_models(geometry: Geometry, joint_boxes: np.ndarray, hulls: np.ndarray) -> FoldModels:
+def fold_models(geometry: Geometry, joint_boxes: np.ndarray, hulls: np.ndarray, rounds: int = ROUNDS) -> FoldModels:
     """Fold models of joint boxes (n, 3, 2) whose singular poses lie in ``hulls`` (n, 3, 2), if provable.
 
-    Each axis k is tried; a model is kept when the Krawczyk box of the singular
-    four-bar system is proved (module docstring) and one of the two connectivity
-    conditions holds.  Certified where ``ok``; no claim elsewhere.
+    Each round evaluates E' and E(m) once over the current pose box X and forms the
+    Krawczyk image K_k for the three axes k.  A model is kept for the first axis whose
+    K_k lies in the interior of X and whose pieces pass a connectivity condition
+    (module docstring).  Otherwise X shrinks to X ∩ K_0 ∩ K_1 ∩ K_2: every singular pose
+    with its joint vector in the box is a zero of each E_k in X, so it stays in the
+    intersection, and a smaller X gives a smaller C.  An EMPTY intersection proves the
+    box holds no singular pose at all: ``void`` (the box is clear,
+    proofs/lemma-fold-joint-box.md, part 6).  Certified where ``ok`` or ``void``.
     """
     n = len(joint_boxes)
-    ok = np.zeros(n, dtype=bool)
+    ok, void = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
     axis = np.full(n, -1, dtype=np.int8)
     pose = np.full((n, 3, 2), np.nan)
     height = Interval(np.full(n, np.nan), np.full(n, np.nan))
@@ -235,83 +249,90 @@ def fold_models(geometry: Geometry, joint_boxes: np.ndarray, hulls: np.ndarray) 
     todo = np.flatnonzero(np.isfinite(hulls).all(axis=(1, 2)))
     for s in range(0, todo.size, _CHUNK):
         idx = todo[s:s + _CHUNK]
-        # the first box X is the same for every axis: its gradients and mid values are computed once
-        H0 = hulls[idx]
-        w0 = H0[:, :, 1] - H0[:, :, 0]
-        X0 = H0 + np.stack([-0.1 * w0 - 1e-9, 0.1 * w0 + 1e-9], axis=-1)
-        grads0 = _gradients(geometry, X0)
-        values0 = _values(geometry, Interval(X0[:, :, 0], X0[:, :, 1]).mid())
-        chunk_pos = np.full(n, -1)
-        chunk_pos[idx] = np.arange(idx.size)
-        for k in range(3):
-            idx = idx[~ok[idx]]
-            if idx.size == 0:
+        w0 = hulls[idx, :, 1] - hulls[idx, :, 0]
+        # a little room around the hull: the inclusion test needs the solutions off the boundary of X
+        X = hulls[idx] + np.stack([-0.1 * w0 - 1e-9, 0.1 * w0 + 1e-9], axis=-1)
+        live = np.arange(idx.size)
+        for _round in range(rounds):
+            if live.size == 0:
                 break
-            i, j = [a for a in range(3) if a != k]
-            P = Interval(np.stack([rho.lo[idx, i], rho.lo[idx, j]], 1), np.stack([rho.hi[idx, i], rho.hi[idx, j]], 1))
-            at = chunk_pos[idx]
-            X = X0[at]
-            done = np.zeros(idx.size, dtype=bool)
-            K_ok = np.full(X.shape, np.nan)
-            Y_ok = np.full((idx.size, 3, 3), np.nan)
-            C_ok = Interval(np.full((idx.size, 3, 3), np.nan), np.full((idx.size, 3, 3), np.nan))
-            for _round in range(INFLATE_ROUNDS):
-                live = np.flatnonzero(~done)
-                if live.size == 0:
-                    break
-                if _round == 0:
-                    first = at[live]
-                    grads = (grads0[0][first], grads0[1][first])
-                    vals = (values0[0][first], values0[1][first])
-                else:
-                    grads, vals = _gradients(geometry, X[live]), None
+            Xl = X[live]
+            grads = _gradients(geometry, Xl)
+            vals = _values(geometry, Interval(Xl[:, :, 0], Xl[:, :, 1]).mid())
+            shrunk, grown = Xl.copy(), Xl.copy()
+            done = np.zeros(live.size, dtype=bool)
+            for k in range(3):
+                i, j = [a for a in range(3) if a != k]
+                rows = idx[live]
+                P = Interval(np.stack([rho.lo[rows, i], rho.lo[rows, j]], 1),
+                             np.stack([rho.hi[rows, i], rho.hi[rows, j]], 1))
                 Y, C = _preconditioned(grads, k)
-                K = _krawczyk(geometry, X[live], k, P[live], Y, C, vals)
-                good = _inside(K, X[live])
-                K_ok[live[good]], Y_ok[live[good]] = K[good], Y[good]
-                C_ok.lo[live[good]], C_ok.hi[live[good]] = C.lo[good], C.hi[good]
-                done[live[good]] = True
-                # epsilon inflation of the hull with the image (X only grows: it keeps every singular pose)
-                bad = live[~good]
-                Kb = K[~good]
-                fin = np.isfinite(Kb).all(axis=(1, 2))
-                grown = X[bad].copy()
-                grown[fin, :, 0] = np.minimum(grown[fin, :, 0], Kb[fin, :, 0])
-                grown[fin, :, 1] = np.maximum(grown[fin, :, 1], Kb[fin, :, 1])
-                gw = grown[:, :, 1] - grown[:, :, 0]
-                X[bad] = grown + np.stack([-0.25 * gw, 0.25 * gw], axis=-1)
-            sel = np.flatnonzero(done)
-            if sel.size == 0:
-                continue
-            Kd, Xd = K_ok[sel], X[sel]
-            hk = rho_sq_interval(geometry, Kd)[:, k].sqrt()
-            inside_k = (hk.lo > rho.lo[idx[sel], k]) & (hk.hi < rho.hi[idx[sel], k])
-            sg = _normal_signs(geometry, Kd)
-            monotone = (sg[:, i] != 0) & (sg[:, j] != 0) & (sg[:, k] != 0)
-            good = inside_k | monotone
-            R = rho[idx[sel]]
-            for a, b in ((0, 1), (1, 0)):  # monotone along parameter b, both end edges checked along a
-                cand = np.flatnonzero(~good & (sg[:, k] != 0) & (sg[:, (i, j)[b]] != 0))
+                K = _krawczyk(geometry, Xl, k, P, Y, C, vals)
+                fin = np.isfinite(K).all(axis=(1, 2))
+                shrunk[fin, :, 0] = np.maximum(shrunk[fin, :, 0], K[fin, :, 0])
+                shrunk[fin, :, 1] = np.minimum(shrunk[fin, :, 1], K[fin, :, 1])
+                grown[fin, :, 0] = np.minimum(grown[fin, :, 0], K[fin, :, 0])
+                grown[fin, :, 1] = np.maximum(grown[fin, :, 1], K[fin, :, 1])
+                cand = np.flatnonzero(~done & _inside(K, Xl))
                 if cand.size == 0:
                     continue
-                rb = (i, j)[b]
-                rising = -sg[cand, rb] * sg[cand, k] > 0  # dh/dr_b > 0
-                top = np.where(rising, R.hi[cand, rb], R.lo[cand, rb])  # where h is largest along b
-                low = np.where(rising, R.lo[cand, rb], R.hi[cand, rb])
-                edge = []
-                for at in (top, low):
-                    lo_p, hi_p = np.empty((cand.size, 2)), np.empty((cand.size, 2))
-                    lo_p[:, a], hi_p[:, a] = R.lo[cand, (i, j)[a]], R.hi[cand, (i, j)[a]]
-                    lo_p[:, b], hi_p[:, b] = at, at
-                    edge.append(_height(geometry, Xd[cand], k, Interval(lo_p, hi_p), Y_ok[sel[cand]], C_ok[sel[cand]]))
-                good[cand] = (edge[0].lo > R.lo[cand, k]) & (edge[1].hi < R.hi[cand, k])
-            g = idx[sel[good]]
-            ok[g], axis[g] = True, k
-            pose[g] = Xd[good]
-            height.lo[g], height.hi[g] = hk.lo[good], hk.hi[good]
-            inv[g] = Y_ok[sel[good]]
-            contraction.lo[g], contraction.hi[g] = C_ok.lo[sel[good]], C_ok.hi[sel[good]]
-    return FoldModels(ok, axis, pose, height, inv, contraction)
+                good, hk = _connected(geometry, K[cand], Xl[cand], k, rho[rows[cand]], Y[cand], C[cand])
+                g = cand[good]
+                done[g] = True
+                ok[rows[g]], axis[rows[g]] = True, k
+                pose[rows[g]] = Xl[g]
+                height.lo[rows[g]], height.hi[rows[g]] = hk.lo[good], hk.hi[good]
+                inv[rows[g]] = Y[g]
+                contraction.lo[rows[g]], contraction.hi[rows[g]] = C.lo[g], C.hi[g]
+            empty = (shrunk[:, :, 0] > shrunk[:, :, 1]).any(axis=1)
+            void[idx[live[empty]]] = True
+            if _round < rounds - INFLATE_ROUNDS:
+                X[live[~empty]] = shrunk[~empty]
+            else:
+                # the sheet may leave the box: the zeros of E over the whole parameter box then reach
+                # outside the hull, and X must grow to hold them (it still holds every singular pose)
+                X[live] = _inflated(Xl, grown)
+            live = live[~done & ~empty]
+    # no singular pose at all beats a sheet whose height leaves the box: the box is clear
+    ok &= ~void
+    axis[void] = -1
+    return FoldModels(ok, axis, pose, height, inv, contraction, void)
+
+
+def _inflated(X: np.ndarray, grown: np.ndarray) -> np.ndarray:
+    """Epsilon inflation: the hull of X and its images, widened by a quarter on each side."""
+    gw = grown[:, :, 1] - grown[:, :, 0]
+    return grown + np.stack([-0.25 * gw, 0.25 * gw], axis=-1)
+
+
+def _connected(geometry: Geometry, K: np.ndarray, X: np.ndarray, k: int, R: Interval, Y: np.ndarray,
+               C: Interval) -> tuple[np.ndarray, Interval]:
+    """(which models of axis k have two connected pieces, the enclosure of h = rho_k over K).
+
+    Conditions (a), (b), (c) of the module docstring, for Krawczyk images K inside pose
+    boxes X over joint boxes R.
+    """
+    i, j = [a for a in range(3) if a != k]
+    hk = rho_sq_interval(geometry, K)[:, k].sqrt()
+    inside_k = (hk.lo > R.lo[:, k]) & (hk.hi < R.hi[:, k])
+    sg = _normal_signs(geometry, K)
+    good = inside_k | ((sg[:, i] != 0) & (sg[:, j] != 0) & (sg[:, k] != 0))
+    for a, b in ((0, 1), (1, 0)):  # monotone along parameter b, both end edges checked along a
+        cand = np.flatnonzero(~good & (sg[:, k] != 0) & (sg[:, (i, j)[b]] != 0))
+        if cand.size == 0:
+            continue
+        rb, ra = (i, j)[b], (i, j)[a]
+        rising = -sg[cand, rb] * sg[cand, k] > 0  # dh/dr_b > 0
+        top = np.where(rising, R.hi[cand, rb], R.lo[cand, rb])  # where h is largest along b
+        low = np.where(rising, R.lo[cand, rb], R.hi[cand, rb])
+        edge = []
+        for at in (top, low):
+            lo_p, hi_p = np.empty((cand.size, 2)), np.empty((cand.size, 2))
+            lo_p[:, a], hi_p[:, a] = R.lo[cand, ra], R.hi[cand, ra]
+            lo_p[:, b], hi_p[:, b] = at, at
+            edge.append(_height(geometry, X[cand], k, Interval(lo_p, hi_p), Y[cand], C[cand]))
+        good[cand] = (edge[0].lo > R.lo[cand, k]) & (edge[1].hi < R.hi[cand, k])
+    return good, hk
 
 
 def _height(geometry: Geometry, X: np.ndarray, k: int, P: Interval, Y: np.ndarray, C: Interval) -> Interval:

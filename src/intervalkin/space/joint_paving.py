@@ -40,10 +40,11 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.paving.budget import check_depth
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving, box_bounds, split_boxes
-from intervalkin.solve.fold_model import fold_models, pose_hulls, side_of
+from intervalkin.solve.fold_model import side_of
 from intervalkin.solve.joint_box import initial_cells, live_cells
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
-from intervalkin.space.joint_pieces import FoldPieces, fold_pieces
+from intervalkin.space.joint_models import ModelStore
+from intervalkin.space.joint_pieces import FoldPieces
 
 __all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain", "DEFAULT_JOINT_DEPTH", "JOIN_LEVELS"]
 
@@ -53,6 +54,8 @@ DEFAULT_JOINT_DEPTH = 7
 JOIN_LEVELS = 2
 #: Further levels in the undecided boxes that touch a face of the joint box (where thin cells hug the limits).
 FACE_LEVELS = 0
+#: Further levels in the undecided boxes that local models could not settle (with ``fold``).
+MODEL_LEVELS = 0
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,6 +68,9 @@ class JointSpacePaving:
         off g(S); BOUNDARY: undecided at the deepest level or not yet split).
     cell : (n,) int32, the cell of each clear box, -1 for undecided boxes.
     cells : one :class:`JointSpaceCell` per cell, largest first.
+    pieces, piece_cell : the fold boxes' pieces and the cell of each piece (-1: joined to none).
+    fold_stats : figures of the local models (fold boxes, boxes proved clear by exclusion, ...).
+    voided : (n,) bool, clear leaves proved clear by Krawczyk exclusion rather than by the torus search.
     """
 
     paving: Paving
@@ -73,6 +79,7 @@ class JointSpacePaving:
     pieces: FoldPieces | None = None
     piece_cell: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int32))
     fold_stats: dict = field(default_factory=dict)
+    voided: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
 
     def counted_fold_mask(self) -> np.ndarray:
         """(n,) bool: the leaves that are fold boxes whose two pieces both lie in cells of known count."""
@@ -225,7 +232,7 @@ def _to_paving(domain: np.ndarray, leaves: tuple[np.ndarray, ...], stats: list[d
 
 def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_levels: int = JOIN_LEVELS,
                      progress: Callable[[dict], None] | None = None, fold: bool = False,
-                     face_levels: int = FACE_LEVELS) -> JointSpacePaving:
+                     face_levels: int = FACE_LEVELS, model_levels: int = MODEL_LEVELS) -> JointSpacePaving:
     """Pave the joint box to ``depth`` with the clear-box test, join cells across walls, and count them.
 
     Parameters
@@ -234,59 +241,80 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         range / 2**depth); 1..11, memory checked before any work.
     join_levels : further levels, only in undecided boxes that separate two cells of
         equal count and split (0: no joins).
-    fold : give the undecided leaves fold models (:mod:`intervalkin.solve.fold_model`) where
-        they can be proved; their pieces join the cells and count as certified volume.  Off by
-        default: at depth 7 it certifies 2.6 % more of the joint box (87.5 % -> 90.1 %) for
-        about three times the time (23.5 s -> 77 s), and changes no cell of the paper's manipulator.
+    fold : give the undecided leaves local models (:mod:`intervalkin.solve.local_model`):
+        leaves proved free of singular poses by Krawczyk exclusion become clear, leaves cut
+        by one proved fold sheet get two pieces that join the cells and count as certified
+        volume.
+    face_levels : further levels in the undecided leaves that touch a face of the joint box.
+    model_levels : with ``fold``, further levels in the leaves left without a model (split,
+        re-tested, modelled again), the last step of the local refinement.
 
     Cost: the undecided boxes lie along the 2-D surface g(S), so their number grows
     like 4**depth; each cell costs one certified solve.
     """
     check_depth(depth)
-    for name, v in (("join_levels", join_levels), ("face_levels", face_levels)):
+    for name, v in (("join_levels", join_levels), ("face_levels", face_levels), ("model_levels", model_levels)):
         if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 8:
             raise InputError(f"{name}: expected an integer in 0..8, got {v!r}")
     domain = joint_domain(geometry)
     found_leaves, stats = _adaptive(geometry, domain, depth, progress)
     leaves = found_leaves.merge()
+    store = ModelStore(geometry) if fold else None
+    settle = (lambda lv: store.settle(lv)) if store is not None else (lambda lv: lv)
+    leaves = _timed(progress, "local models", depth, lambda: settle(leaves), leaves)
+    for extra in range(model_levels if store is not None else 0):
+        wall = store.unresolved(leaves) & (leaves[0] >= depth + extra)
+        if not np.any(wall):
+            break
+        leaves = _timed(progress, "local refinement", depth + extra + 1,
+                        lambda: settle(_refine(geometry, domain, leaves, wall)), leaves, wall)
     for extra in range(face_levels):
         # thin cells hug the faces rho_i = rho_min / rho_max: refine the undecided leaves that touch one
         level, lo, hi, clear = leaves[0], leaves[2], leaves[3], leaves[4]
         touch = ((lo <= domain[:, 0]) | (hi >= domain[:, 1])).any(axis=1)
         wall = ~clear & touch & (level >= depth + extra)
-        if progress is not None:
-            progress({"stage": "faces", "level": depth + extra + 1, "depth": depth + face_levels,
-                      "boxes": int(np.count_nonzero(wall)), "split": int(np.count_nonzero(wall))})
         if not np.any(wall):
             break
-        leaves = _refine(geometry, domain, leaves, wall)
-    fine = depth + max(face_levels, join_levels)
+        leaves = _timed(progress, "faces", depth + extra + 1,
+                        lambda: settle(_refine(geometry, domain, leaves, wall)), leaves, wall)
+    fine = int(leaves[0].max())
     cells = CellSolver(geometry)
-    store = _FoldStore(geometry) if fold else None
     for extra in range(join_levels + 1):
         paving = _to_paving(domain, leaves, stats)
         cell, found, _, _ = cells.label(paving, fine)
         if extra == join_levels:
             break
         wall = joining_paths(cells.edges, cell, found) & (paving.level < depth + join_levels)
-        if progress is not None:
-            progress({"stage": "joins", "level": depth + extra + 1, "depth": depth + join_levels,
-                      "boxes": int(np.count_nonzero(wall)), "split": int(np.count_nonzero(wall)), "cells": len(found)})
         if not np.any(wall):
             break
-        leaves = _refine(geometry, domain, leaves, wall)
+        leaves = _timed(progress, "joins", depth + extra + 1,
+                        lambda: settle(_refine(geometry, domain, leaves, wall)), leaves, wall)
+        fine = max(fine, int(leaves[0].max()))
     pieces, piece_cell, fold_stats = None, np.zeros(0, dtype=np.int32), {}
-    if fold:
+    if store is not None:
         t0 = time.perf_counter()
-        store = _FoldStore(geometry)
+        paving = _to_paving(domain, leaves, stats)
         cell, found, pieces, piece_cell = cells.label(paving, fine, lambda e: store.pieces(leaves, e))
         unjoined = cells.unjoined
         fold_stats = {"fold_boxes": 0 if pieces is None else len(pieces), "seconds": time.perf_counter() - t0,
+                      "void_boxes": int(store.void_keys.size), "void_volume": store.void_volume,
                       "unjoined_piece_groups": unjoined[0], "unjoined_piece_volume": unjoined[1]}
         if progress is not None:
-            progress({"stage": "fold models", "level": depth + join_levels, "depth": depth + join_levels,
+            progress({"stage": "fold pieces", "level": fine, "depth": fine,
                       "boxes": fold_stats["fold_boxes"], "split": 0, "cells": len(found)})
-    return JointSpacePaving(paving, cell, tuple(found), pieces, piece_cell, fold_stats)
+    voided = store.voided(paving.level, paving.ijk) if store is not None else np.zeros(len(cell), dtype=bool)
+    return JointSpacePaving(paving, cell, tuple(found), pieces, piece_cell, fold_stats, voided)
+
+
+def _timed(progress, stage: str, level: int, step: Callable, leaves, wall=None):
+    """Run one refinement step, reporting the boxes it split and the leaves left unresolved."""
+    t0 = time.perf_counter()
+    out = step()
+    if progress is not None:
+        progress({"stage": stage, "level": level, "depth": level, "seconds": time.perf_counter() - t0,
+                  "boxes": int(len(out[0])), "split": 0 if wall is None else int(np.count_nonzero(wall)),
+                  "undecided": int(np.count_nonzero(~out[4]))})
+    return out
 
 
 def _refine(geometry: Geometry, domain: np.ndarray, leaves: tuple[np.ndarray, ...], wall: np.ndarray):
@@ -304,47 +332,3 @@ def _refine(geometry: Geometry, domain: np.ndarray, leaves: tuple[np.ndarray, ..
     out.parts.append((level[keep], ijk[keep], lo[keep], hi[keep], clear[keep], pos[owner[~sel]], cells[~sel]))
     out.add(front, clo, chi, cclear, np.ones(len(cclear), dtype=bool))
     return out.merge()
-
-
-def _leaf_keys(level: np.ndarray, ijk: np.ndarray) -> np.ndarray:
-    ijk = np.asarray(ijk, dtype=np.int64)
-    return (np.asarray(level, dtype=np.int64) << 48) | (ijk[:, 0] << 32) | (ijk[:, 1] << 16) | ijk[:, 2]
-
-
-class _FoldStore:
-    """Fold models of undecided leaves, computed once per leaf (joins re-label the paving several times)."""
-
-    def __init__(self, geometry: Geometry):
-        self.geometry = geometry
-        self.keys = np.zeros(0, dtype=np.int64)
-        self.models = None
-
-    def _update(self, leaves: tuple[np.ndarray, ...]) -> np.ndarray:
-        """Row of each undecided leaf in the store (-1: no model), computing the new ones."""
-        level, ijk, lo, hi, clear, owner, cells = leaves
-        und = np.flatnonzero(~clear)
-        keys = _leaf_keys(level[und], ijk[und])
-        new = ~np.isin(keys, self.keys)
-        if new.any():
-            fresh = und[new]
-            pos = np.full(len(level), -1)
-            pos[fresh] = np.arange(fresh.size)
-            sel = pos[owner] >= 0
-            boxes = np.stack([lo[fresh], hi[fresh]], axis=-1)
-            hulls = pose_hulls(self.geometry, boxes, pos[owner[sel]], cells[sel])
-            m = fold_models(self.geometry, boxes, hulls)
-            self.models = m if self.models is None else self.models.concat(m)
-            self.keys = np.concatenate([self.keys, keys[new]])
-        order = np.argsort(self.keys, kind="stable")
-        at = order[np.searchsorted(self.keys[order], keys)]
-        row = np.full(len(level), -1, dtype=np.int64)
-        row[und] = np.where(self.models.ok[at], at, -1)
-        return row
-
-    def pieces(self, leaves: tuple[np.ndarray, ...], face_edges: np.ndarray) -> FoldPieces | None:
-        row = self._update(leaves)
-        box = np.flatnonzero(row >= 0)
-        if box.size == 0:
-            return None
-        level, ijk, lo, hi, clear = leaves[:5]
-        return fold_pieces(self.geometry, lo, hi, clear, face_edges, box, self.models.take(row[box]))
