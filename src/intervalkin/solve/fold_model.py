@@ -49,8 +49,9 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, PI_LO, Interval
 from intervalkin.kinematics.constants import constants
-from intervalkin.kinematics.enclosures import (det_a_gradient_interval, det_a_interval, jacobian_interval,
-                                               rho_sq_interval)
+from intervalkin.kinematics.enclosures import (det_a_gradient_interval, jacobian_interval, rho_sq_interval,
+                                               rho_sq_leg_interval)
+from intervalkin.kinematics.point_enclosures import rho_sq_det_at
 
 __all__ = ["FoldModels", "fold_models", "side_of", "pose_hulls"]
 
@@ -149,8 +150,7 @@ def _gradients(geometry: Geometry, X: np.ndarray) -> tuple[Interval, Interval]:
 
 def _values(geometry: Geometry, m: np.ndarray) -> tuple[Interval, Interval]:
     """(rho_l^2, det A) at float poses m (n, 3), enclosed."""
-    pts = np.stack([m, m], axis=-1)
-    return rho_sq_interval(geometry, pts), det_a_interval(geometry, pts)
+    return rho_sq_det_at(geometry, m)
 
 
 def _residual(values: tuple[Interval, Interval], k: int, P: Interval) -> Interval:
@@ -371,20 +371,23 @@ def side_of(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.
         i, j = [a for a in range(3) if a != k]
         P = Interval.point(q[sel][:, [i, j]])
         X = models.pose[box[sel]].copy()
-        alive = np.ones(sel.size, dtype=bool)
         rows = box[sel]
-        for _ in range(SIDE_STEPS):
-            K = _krawczyk(geometry, X, k, P, models.inv[rows], models.contraction[rows])
-            fin = np.isfinite(K).all(axis=(1, 2))
-            alive &= fin
-            K = np.where(fin[:, None, None], K, X)
-            X = np.stack([np.maximum(X[:, :, 0], K[:, :, 0]), np.minimum(X[:, :, 1], K[:, :, 1])], axis=-1)
-        empty = (X[:, :, 0] > X[:, :, 1]).any(axis=1)
-        alive &= ~empty  # an empty intersection cannot happen for a proved model; claim nothing then
-        X = np.where(alive[:, None, None], X, models.pose[box[sel]])
-        h2 = rho_sq_interval(geometry, X)[:, k]
         qk2 = Interval.point(q[sel, k]).sqr()
-        below = alive & (qk2.hi < h2.lo)
-        above = alive & (qk2.lo > h2.hi)
-        out[sel] = np.where(below, -1, np.where(above, 1, 0))
+        todo = np.arange(sel.size)
+        for _ in range(SIDE_STEPS):  # most points are placed after one step: stop there
+            t = todo
+            K = _krawczyk(geometry, X[t], k, P[t], models.inv[rows[t]], models.contraction[rows[t]])
+            fin = np.isfinite(K).all(axis=(1, 2))
+            K = np.where(fin[:, None, None], K, X[t])
+            Xt = np.stack([np.maximum(X[t, :, 0], K[:, :, 0]), np.minimum(X[t, :, 1], K[:, :, 1])], axis=-1)
+            # an empty intersection cannot happen for a proved model; claim nothing then
+            dead = ~fin | (Xt[:, :, 0] > Xt[:, :, 1]).any(axis=1)
+            X[t] = Xt
+            h2 = rho_sq_leg_interval(geometry, np.where(dead[:, None, None], models.pose[rows[t]], Xt), k)
+            below = ~dead & (qk2.hi[t] < h2.lo)
+            above = ~dead & (qk2.lo[t] > h2.hi)
+            out[sel[t[below]]], out[sel[t[above]]] = -1, 1
+            todo = t[~dead & ~below & ~above]
+            if todo.size == 0:
+                break
     return out

@@ -57,6 +57,9 @@ class JointSpaceCell:
     n_wa1: int
     n_wa2: int
     witness: tuple[Fraction, Fraction, Fraction]
+    #: a component made only of boxes of the local refinement inside the undecided layer, touching
+    #: no face of the joint box: part of some component of (joint box minus g(S)) not joined to it
+    fragment: bool = False
 
     @property
     def signature(self) -> tuple[int, int, int]:
@@ -64,7 +67,8 @@ class JointSpaceCell:
 
     def to_json(self) -> dict:
         return {"id": self.id, "boxes": self.boxes, "volume": self.volume, "count": self.count,
-                "n_wa1": self.n_wa1, "n_wa2": self.n_wa2, "witness": [str(v) for v in self.witness]}
+                "n_wa1": self.n_wa1, "n_wa2": self.n_wa2, "witness": [str(v) for v in self.witness],
+                "fragment": self.fragment}
 
 
 def _keys(level: np.ndarray, ijk: np.ndarray) -> np.ndarray:
@@ -97,14 +101,16 @@ class CellSolver:
         return (-1, -1, -1), witness
 
     def label(self, paving: Paving, fine_depth: int,
-              pieces_of: Callable[[np.ndarray], FoldPieces | None] | None = None
+              pieces_of: Callable[[np.ndarray], FoldPieces | None] | None = None,
+              anchor: np.ndarray | None = None
               ) -> tuple[np.ndarray, list[JointSpaceCell], FoldPieces | None, np.ndarray]:
         """(cell id per box (-1 where undecided), the cells largest first, the fold pieces, cell id per piece).
 
         ``pieces_of(face_edges)``, when given, returns the fold pieces of the paving's
         undecided boxes (:mod:`intervalkin.space.joint_pieces`); their edges join clear
         boxes and pieces into cells, and a cell with no clear box is solved at a
-        witness of one of its pieces.
+        witness of one of its pieces.  ``anchor`` (n,) bool, when given: components with
+        no clear anchor box are *fragments*, listed after the cells (ids follow theirs).
         """
         ok = paving.labels["clear"] == Label.INSIDE
         n = len(paving)
@@ -152,7 +158,10 @@ class CellSolver:
             pv = np.repeat(vol[pieces.box], 2) / 2.0
             has = piece_comp >= 0
             comp_vol += np.bincount(piece_comp[has], weights=pv[has], minlength=ncomp)
-        order = np.argsort(-comp_vol, kind="stable")
+        anchored = np.ones(ncomp, dtype=bool)
+        if anchor is not None:
+            anchored = np.bincount(comp[ok & anchor], minlength=ncomp) > 0
+        order = np.lexsort((-comp_vol, ~anchored))  # the cells by volume, then the fragments
         new_id = np.empty(ncomp, dtype=np.int64)
         new_id[order] = np.arange(ncomp)
         # the largest boxes of each component first: their centres are farthest from g(S)
@@ -181,7 +190,8 @@ class CellSolver:
                             sig, witness = self._signature(w, w)
                             if sig[0] >= 0:
                                 break
-            cells.append(JointSpaceCell(int(new_id[c]), int(box_count[c]), float(comp_vol[c]), *sig, witness))
+            cells.append(JointSpaceCell(int(new_id[c]), int(box_count[c]), float(comp_vol[c]), *sig, witness,
+                                        not bool(anchored[c])))
         cell = np.full(len(paving), -1, dtype=np.int32)
         cell[ok] = new_id[comp[ok]]
         piece_cell = np.where(piece_comp >= 0, new_id[np.maximum(piece_comp, 0)], -1).astype(np.int32)

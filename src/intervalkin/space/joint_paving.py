@@ -71,6 +71,11 @@ class JointSpacePaving:
     pieces, piece_cell : the fold boxes' pieces and the cell of each piece (-1: joined to none).
     fold_stats : figures of the local models (fold boxes, boxes proved clear by exclusion, ...).
     voided : (n,) bool, clear leaves proved clear by Krawczyk exclusion rather than by the torus search.
+    fragments : components of certified boxes made only by the local refinement inside the
+        undecided layer and touching no face of the joint box (islands near cusps and crossings
+        of g(S)); each has a certified count and lies in some component of the joint box minus
+        g(S), but it is not joined to one, so it is listed apart and not counted as a cell.  Their
+        ids follow the cells' ids.
     """
 
     paving: Paving
@@ -80,12 +85,14 @@ class JointSpacePaving:
     piece_cell: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int32))
     fold_stats: dict = field(default_factory=dict)
     voided: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    fragments: tuple[JointSpaceCell, ...] = ()
 
     def counted_fold_mask(self) -> np.ndarray:
         """(n,) bool: the leaves that are fold boxes whose two pieces both lie in cells of known count."""
         out = np.zeros(len(self.cell), dtype=bool)
         if self.pieces is not None and len(self.pieces):
-            known = np.array([c.count >= 0 for c in self.cells] + [False], dtype=bool)
+            every = sorted(self.cells + self.fragments, key=lambda c: c.id)
+            known = np.array([c.count >= 0 for c in every] + [False], dtype=bool)
             pc = self.piece_cell.reshape(-1, 2)
             out[self.pieces.box] = known[pc[:, 0]] & known[pc[:, 1]]
         return out
@@ -128,7 +135,7 @@ class JointSpacePaving:
         the pieces q_k < h and q_k > h, -1 elsewhere or unknown)."""
         count = np.full(len(self.cell), -1, dtype=np.int32)
         wa1, wa2 = count.copy(), count.copy()
-        for c in self.cells:
+        for c in self.cells + self.fragments:
             m = self.cell == c.id
             count[m], wa1[m], wa2[m] = c.count, c.n_wa1, c.n_wa2
         axis, below, above = count.copy(), count.copy(), count.copy()
@@ -279,9 +286,14 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
                         lambda: settle(_refine(geometry, domain, leaves, wall)), leaves, wall)
     fine = int(leaves[0].max())
     cells = CellSolver(geometry)
+
+    def anchor(lv):  # boxes of the uniform paving and of the face refinement may start a cell
+        touch = ((lv[2] <= domain[:, 0]) | (lv[3] >= domain[:, 1])).any(axis=1)
+        return (lv[0] <= depth) | touch
+
     for extra in range(join_levels + 1):
         paving = _to_paving(domain, leaves, stats)
-        cell, found, _, _ = cells.label(paving, fine)
+        cell, found, _, _ = cells.label(paving, fine, anchor=anchor(leaves))
         if extra == join_levels:
             break
         wall = joining_paths(cells.edges, cell, found) & (paving.level < depth + join_levels)
@@ -294,7 +306,8 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     if store is not None:
         t0 = time.perf_counter()
         paving = _to_paving(domain, leaves, stats)
-        cell, found, pieces, piece_cell = cells.label(paving, fine, lambda e: store.pieces(leaves, e))
+        cell, found, pieces, piece_cell = cells.label(paving, fine, lambda e: store.pieces(leaves, e),
+                                                      anchor(leaves))
         unjoined = cells.unjoined
         fold_stats = {"fold_boxes": 0 if pieces is None else len(pieces), "seconds": time.perf_counter() - t0,
                       "void_boxes": int(store.void_keys.size), "void_volume": store.void_volume,
@@ -303,7 +316,8 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
             progress({"stage": "fold pieces", "level": fine, "depth": fine,
                       "boxes": fold_stats["fold_boxes"], "split": 0, "cells": len(found)})
     voided = store.voided(paving.level, paving.ijk) if store is not None else np.zeros(len(cell), dtype=bool)
-    return JointSpacePaving(paving, cell, tuple(found), pieces, piece_cell, fold_stats, voided)
+    return JointSpacePaving(paving, cell, tuple(c for c in found if not c.fragment), pieces, piece_cell,
+                            fold_stats, voided, tuple(c for c in found if c.fragment))
 
 
 def _timed(progress, stage: str, level: int, step: Callable, leaves, wall=None):
