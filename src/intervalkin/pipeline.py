@@ -55,7 +55,7 @@ from intervalkin.space.basic_region import (
     label_pose,
 )
 from intervalkin.space.joint_cells import regions_from_cells
-from intervalkin.space.joint_paving import JOIN_LEVELS, JointSpacePaving
+from intervalkin.space.joint_paving import JOIN_LEVELS, MODEL_LEVELS, JointSpacePaving
 from intervalkin.space.joint_paving import pave_joint_space as pave_joint_cells
 from intervalkin.space.joint_space import JointPaving, joint_paving
 from intervalkin.space.pose_label import PoseLabel
@@ -347,7 +347,8 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     dw, ds, dj = chain_depths(depth)
     stages = _Stages(progress)
     joint = _joint_space(geometry, ds, dj, stages)
-    name = f"joint space paved directly (depth {dj}, {JOIN_LEVELS} join levels)"
+    name = (f"joint space paved directly (depth {dj - 1}, local models, {MODEL_LEVELS} level of local refinement, "
+            f"{JOIN_LEVELS} join levels)")
     with contextlib.ExitStack() as side:
         future = None
         daemonic = multiprocessing.current_process().daemon
@@ -355,10 +356,10 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
             # the two pavings are independent: the joint one runs in a second process beside the regions
             # (not from a daemonic process, such as a Dask worker, which may not have children: in-process there)
             pool = side.enter_context(ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")))
-            future = pool.submit(pave_joint_cells, geometry, dj, JOIN_LEVELS)
+            future = pool.submit(pave_joint_cells, geometry, dj - 1, JOIN_LEVELS)
         else:
             with stages.stage(name) as levels:
-                cells = pave_joint_cells(geometry, dj, JOIN_LEVELS, progress=levels)
+                cells = pave_joint_cells(geometry, dj - 1, JOIN_LEVELS, progress=levels)
         with stages.stage(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})") as levels:
             regions = analyse_regions(geometry, joint, dw, progress=levels)
         with stages.stage("aspects: covers proving each sign of det A connected"):

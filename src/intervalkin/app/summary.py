@@ -109,23 +109,35 @@ def joint_summary(jp: JointPaving) -> dict:
 def joint_cells_summary(jp) -> dict:
     """The direct joint paving: its resolution, certified share, cells (each with its certified count) and levels."""
     stats = jp.paving.stats
+    uniform = [st for st in stats if st["stage"] == "joint paving"]
+    fs = jp.fold_stats
     return {
-        "depth": int(stats[-1]["depth"]) if stats else 0,
+        "depth": int(uniform[-1]["depth"]) if uniform else 0,
         "deepest_level": int(jp.paving.level.max()),
         "boxes": len(jp.paving),
         "certified_share": jp.certified_share(),
         "undecided_volume": jp.undecided_volume(),
         "undecided_volume_per_level": [st["undecided_volume"]["clear"] for st in stats],
+        "stages": [{"stage": st["stage"], "level": int(st["level"]), "boxes": int(st["boxes"]),
+                    "seconds": float(st.get("seconds", 0.0)),
+                    "undecided_volume": float(st["undecided_volume"]["clear"]),
+                    "without_model_volume": float(st["undecided_volume"].get("model", st["undecided_volume"]["clear"]))}
+                   for st in stats],
         "cells": [c.to_json() for c in jp.cells],
-        "fold_boxes": int(jp.fold_stats.get("fold_boxes", 0)),
-        "unjoined_fold_pieces": {"groups": int(jp.fold_stats.get("unjoined_piece_groups", 0)),
-                                 "volume": float(jp.fold_stats.get("unjoined_piece_volume", 0.0))},
-        "certified": "every box of a cell is proved off g(S) (no singular pose has its joint vector in it), or is "
-                     "a fold box: one sheet of g(S) crosses it as a certified graph and each of its two pieces is "
-                     "joined to the cell through a point placed in both; each cell's count and aspect split come "
-                     "from one complete certified solve at its witness and hold at every point of the cell; cells "
-                     "are not proved to be different components; fold pieces joined to no clear box are counted "
-                     "under unjoined_fold_pieces (their counts are not computed)",
+        "fragments": [c.to_json() for c in jp.fragments],
+        "fold_boxes": int(fs.get("fold_boxes", 0)),
+        "boxes_cleared_by_exclusion": {"boxes": int(fs.get("void_boxes", 0)), "volume": float(fs.get("void_volume", 0.0))},
+        "unjoined_fold_pieces": {"groups": int(fs.get("unjoined_piece_groups", 0)),
+                                 "volume": float(fs.get("unjoined_piece_volume", 0.0))},
+        "certified": "every box of a cell is proved off g(S) (no singular pose has its joint vector in it: by the "
+                     "torus search or by Krawczyk exclusion), or is a fold box: one sheet of g(S) crosses it as a "
+                     "certified graph and each of its two pieces is joined to the cell through a point placed in "
+                     "both; each cell's count and aspect split come from one complete certified solve at its "
+                     "witness and hold at every point of the cell; cells are not proved to be different "
+                     "components; fragments are certified islands inside the undecided layer, made only by the "
+                     "local refinement and touching no face of the joint box: each lies in some component but is "
+                     "not joined to one, so they are listed, not counted; fold pieces joined to no clear box are "
+                     "counted under unjoined_fold_pieces (their counts are not computed)",
     }
 
 
