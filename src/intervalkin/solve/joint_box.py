@@ -34,6 +34,11 @@ is not a singularity).
 Inheritance: a cell discarded for R is discarded for every sub-box of R (the
 enclosures over a sub-box are subsets), so a paving hands a box's live cells to
 its children and re-tests only those.
+
+Sharing: the pose box of a cell depends on R_1 and the cell only, so the enclosures
+are computed once per distinct (R_1, cell) (:func:`intervalkin.core.rows.distinct_rows`,
+bitwise) and compared with each box's R_2, R_3: the same floats as one evaluation per
+box, so the same cells are discarded.
 """
 
 from __future__ import annotations
@@ -42,8 +47,9 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, Interval
+from intervalkin.core.rows import distinct_rows
 from intervalkin.kinematics.constants import constants
-from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_interval
+from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_leg_interval
 
 __all__ = ["Cells", "initial_cells", "live_cells", "clear_boxes", "ROUNDS", "MAX_CELLS"]
 
@@ -54,29 +60,37 @@ PHI_CELLS = 24
 ROUNDS = 2
 #: A box with more live cells than this after a round stops bisecting them (it straddles g(S)).
 MAX_CELLS = 64
-#: Cells evaluated together (memory).
+#: Pose boxes evaluated together (memory).
 _CHUNK = 65536
 
 #: (owner (m,), cells (m, 4) rows [theta_lo, theta_hi, phi_lo, phi_hi]).
 Cells = tuple[np.ndarray, np.ndarray]
 
 
-def _discard(geometry: Geometry, rho_sq: Interval, rho1: Interval, cells: np.ndarray) -> np.ndarray:
-    """Which cells (m, 4) [theta_lo, theta_hi, phi_lo, phi_hi] hold no singular pose with rho in the box."""
+def _pose_boxes(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """Pose boxes (m, 3, 2) [x] x [y] x Phi of cells (m, 4) with leg 1 in rho1 (m, 2): every pose of the cell."""
     k = constants(geometry)
+    r1 = Interval(rho1[:, 0], rho1[:, 1])
     theta = Interval(cells[:, 0], cells[:, 1])
-    x = rho1 * theta.cos() + k.ax_iv[0]
-    y = rho1 * theta.sin() + k.ay_iv[0]
-    boxes = np.stack([np.stack([x.lo, x.hi], -1), np.stack([y.lo, y.hi], -1), cells[:, 2:4]], axis=1)
-    e = rho_sq_interval(geometry, boxes)
-    out = np.zeros(len(cells), dtype=bool)
+    x = r1 * theta.cos() + k.ax_iv[0]
+    y = r1 * theta.sin() + k.ay_iv[0]
+    return np.stack([np.stack([x.lo, x.hi], -1), np.stack([y.lo, y.hi], -1), cells[:, 2:4]], axis=1)
+
+
+def _rho_sq_legs_23(geometry: Geometry, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi), each (m, 2): columns 2 and 3 of :func:`~intervalkin.kinematics.enclosures.rho_sq_interval`
+    (leg 1 is not needed: B1 is on its circle by construction)."""
+    lo, hi = np.empty((len(boxes), 2)), np.empty((len(boxes), 2))
     for j in (1, 2):
-        out |= (e.hi[:, j] < rho_sq.lo[:, j]) | (e.lo[:, j] > rho_sq.hi[:, j])
-    live = np.flatnonzero(~out)
-    if live.size:
-        det = det_a_interval(geometry, boxes[live])
-        out[live] = (det.lo > 0) | (det.hi < 0)
-    return out
+        e = rho_sq_leg_interval(geometry, boxes, j)
+        lo[:, j - 1], hi[:, j - 1] = e.lo, e.hi
+    return lo, hi
+
+
+def _det_signed(geometry: Geometry, boxes: np.ndarray) -> np.ndarray:
+    """(m,) bool: det A has a proved sign over the box (no singular pose in it)."""
+    det = det_a_interval(geometry, boxes)
+    return (det.lo > 0) | (det.hi < 0)
 
 
 def initial_cells(n: int, theta_cells: int = THETA_CELLS, phi_cells: int = PHI_CELLS) -> Cells:
@@ -109,43 +123,91 @@ def live_cells(geometry: Geometry, joint_boxes: np.ndarray, owner: np.ndarray, c
     cells is returned holds no joint vector of a singular pose: it does not meet g(S).
     Cells are bisected up to ``rounds`` times; a box with more than ``max_cells`` live
     cells after a round stops being bisected (its cells are returned as they are).
+
+    Cost: the enclosures depend on the pose box alone, i.e. on the cell and R_1, and a
+    paving hands one parent's cells to eight children, four of which share R_1 (and many
+    boxes share R_1 and cells across parents: ~29 rows per distinct pose box at depth 7).
+    So each distinct (R_1, cell), a *key*, is evaluated once, bit for bit as for any of its
+    rows, and only the comparison with R_2, R_3 is made per row.  A key's two halves are
+    the keys of its rows' halves, so keys are found once, before the first round.
     """
     owner = np.asarray(owner, dtype=np.int64)
     n = len(joint_boxes)
+    cells = np.asarray(cells, dtype=np.float64).reshape(-1, 4)
     if owner.size == 0:
-        return owner, np.asarray(cells, dtype=np.float64).reshape(0, 4)
-    rho = Interval(joint_boxes[:, :, 0], joint_boxes[:, :, 1])
+        return owner, cells
+    jb = np.asarray(joint_boxes, dtype=np.float64)
+    rho = Interval(jb[:, :, 0], jb[:, :, 1])
     rho_sq = rho.sqr()
+    bounds = [np.ascontiguousarray(v) for j in (1, 2) for v in (rho_sq.lo[:, j], rho_sq.hi[:, j])]
     k = constants(geometry)
     reach = float(np.max(k.radius_iv.hi)) + 1.0  # how far a platform point moves per radian of phi, roughly
+    r1_rep, r1_of = distinct_rows([jb[:, 0, 0], jb[:, 0, 1]])
+    first, key = distinct_rows([r1_of[owner], cells])
+    key_rho1, key_cells = jb[owner[first], 0, :], cells[first]
+    del first, cells
     done_o, done_c = [], []
     for round_ in range(rounds + 1):
-        gone = np.zeros(owner.size, dtype=bool)
-        for s in range(0, owner.size, _CHUNK):
-            b = owner[s:s + _CHUNK]
-            gone[s:s + _CHUNK] = _discard(geometry, rho_sq[b], rho[b][:, 0], cells[s:s + _CHUNK])
-        owner, cells = owner[~gone], cells[~gone]
+        lo, hi = _key_rho_sq(geometry, key_rho1, key_cells)
+        b2l, b2h, b3l, b3h = (v[owner] for v in bounds)
+        gone = (hi[key, 0] < b2l) | (lo[key, 0] > b2h) | (hi[key, 1] < b3l) | (lo[key, 1] > b3h)
+        del b2l, b2h, b3l, b3h
+        live = np.flatnonzero(~gone)
+        gone[live] = _key_det_signed(geometry, key_rho1, key_cells, key[live])[key[live]]
+        owner, key = owner[~gone], key[~gone]
         stop = np.bincount(owner, minlength=n)[owner] > max_cells
         if round_ == rounds:
             stop[:] = True
         done_o.append(owner[stop])
-        done_c.append(cells[stop])
-        owner, cells = owner[~stop], cells[~stop]
+        done_c.append(key_cells[key[stop]])
+        owner, key = owner[~stop], key[~stop]
         if owner.size == 0:
             break
-        # bisect where the pose moves most: rho_1 d(theta) against the platform's reach d(phi)
-        rows = np.arange(len(cells))
-        by_theta = rho.hi[owner, 0] * (cells[:, 1] - cells[:, 0]) >= reach * (cells[:, 3] - cells[:, 2])
-        a = np.where(by_theta, 0, 2)
-        mid = 0.5 * cells[rows, a] + 0.5 * cells[rows, a + 1]
-        left, right = cells.copy(), cells.copy()
-        left[rows, a + 1] = mid
-        right[rows, a] = mid
+        key_rho1, key_cells, key = _bisect(key_rho1, key_cells, key, reach)
         owner = np.concatenate([owner, owner])
-        cells = np.concatenate([left, right])
     o, c = np.concatenate(done_o), np.concatenate(done_c)
     order = np.argsort(o, kind="stable")
     return o[order], c[order]
+
+
+def _key_rho_sq(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi), each (K, 2): rho_2^2 and rho_3^2 over the pose box of each key."""
+    lo, hi = np.empty((len(cells), 2)), np.empty((len(cells), 2))
+    for s in range(0, len(cells), _CHUNK):
+        boxes = _pose_boxes(geometry, rho1[s:s + _CHUNK], cells[s:s + _CHUNK])
+        lo[s:s + _CHUNK], hi[s:s + _CHUNK] = _rho_sq_legs_23(geometry, boxes)
+    return lo, hi
+
+
+def _key_det_signed(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray, used: np.ndarray) -> np.ndarray:
+    """(K,) bool: det A has a proved sign over the pose box of the key; evaluated for the keys in ``used`` only."""
+    out = np.zeros(len(cells), dtype=bool)
+    mark = out.copy()
+    mark[used] = True
+    todo = np.flatnonzero(mark)
+    for s in range(0, todo.size, _CHUNK):
+        t = todo[s:s + _CHUNK]
+        out[t] = _det_signed(geometry, _pose_boxes(geometry, rho1[t], cells[t]))
+    return out
+
+
+def _bisect(rho1: np.ndarray, cells: np.ndarray, key: np.ndarray, reach: float):
+    """Halve the keys the rows use (theta or phi, whichever moves the pose more: rho_1 d(theta)
+    against the platform's reach d(phi)); returns the new keys and the rows' keys, left halves first."""
+    mark = np.zeros(len(cells), dtype=bool)
+    mark[key] = True
+    used = np.flatnonzero(mark)
+    pos = np.cumsum(mark) - 1
+    rho1, cells = rho1[used], cells[used]
+    rows = np.arange(len(cells))
+    by_theta = rho1[:, 1] * (cells[:, 1] - cells[:, 0]) >= reach * (cells[:, 3] - cells[:, 2])
+    a = np.where(by_theta, 0, 2)
+    mid = 0.5 * cells[rows, a] + 0.5 * cells[rows, a + 1]
+    left, right = cells.copy(), cells.copy()
+    left[rows, a + 1] = mid
+    right[rows, a] = mid
+    p = pos[key]
+    return np.concatenate([rho1, rho1]), np.concatenate([left, right]), np.concatenate([p, p + len(used)])
 
 
 def clear_boxes(geometry: Geometry, boxes: np.ndarray, rounds: int = 6) -> np.ndarray:
