@@ -23,6 +23,8 @@ _MIX = np.uint64(0x9E3779B97F4A7C15)
 _FOLD = np.uint64(29)
 #: Hash table sizes (log2): at least twice the rows, within these bounds.
 _MIN_BITS, _MAX_BITS = 10, 23
+#: Rows hashed and compared together.
+_PIECE = 1 << 19
 
 
 def _bits_of(part: np.ndarray) -> np.ndarray:
@@ -32,6 +34,20 @@ def _bits_of(part: np.ndarray) -> np.ndarray:
         p = p.astype(np.int64)
     p = p.view(np.uint64)  # also for a strided column: the item size does not change
     return p[:, None] if p.ndim == 1 else p
+
+
+def _hash(parts: list[np.ndarray], salt: int) -> np.ndarray:
+    h = np.full(len(parts[0]), np.uint64(salt), dtype=np.uint64)
+    tmp = np.empty_like(h)
+    for p in parts:
+        for j in range(p.shape[1]):  # h = mix(h) ^ column, then spread over all bits
+            np.right_shift(h, _FOLD, out=tmp)
+            h ^= tmp
+            h ^= p[:, j]
+            h *= _MIX
+    np.right_shift(h, _FOLD, out=tmp)
+    h ^= tmp
+    return h
 
 
 def distinct_rows(parts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -47,34 +63,37 @@ def distinct_rows(parts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """
     parts = [_bits_of(p) for p in parts]
     m = len(parts[0])
-    rep = np.arange(m, dtype=np.int64)
-    todo, salt = rep.copy(), 0
-    while todo.size:
-        sub = parts if todo.size == m else [p[todo] for p in parts]
-        h = np.full(todo.size, np.uint64(salt), dtype=np.uint64)
-        tmp = np.empty_like(h)
-        for p in sub:
-            for j in range(p.shape[1]):  # h = mix(h) ^ column, then spread over all bits
-                np.right_shift(h, _FOLD, out=tmp)
-                h ^= tmp
-                h ^= p[:, j]
-                h *= _MIX
-        np.right_shift(h, _FOLD, out=tmp)
-        h ^= tmp
-        bits = min(_MAX_BITS, max(_MIN_BITS, int(todo.size).bit_length() + 1))
-        bucket = (h >> np.uint64(64 - bits)).astype(np.intp)
-        del h, tmp
-        table = np.empty(1 << bits, dtype=np.int32 if todo.size < 2**31 else np.int64)
-        table[bucket] = np.arange(todo.size, dtype=table.dtype)  # one row per bucket holds it (any one)
-        held = table[bucket]
-        del table, bucket
-        same = np.ones(todo.size, dtype=bool)
-        for p in sub:
-            q = p[held]  # whole rows at once: one cache line per row
-            for j in range(p.shape[1]):
-                same &= q[:, j] == p[:, j]
-        rep[todo[same]] = todo[held[same]]
-        todo = todo[~same]  # these met another value in their bucket: hash them again
+    if m == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    rep = np.empty(m, dtype=np.int64)
+    todo, salt = None, 0  # None: all rows
+    while todo is None or todo.size:
+        sub = parts if todo is None else [p[todo] for p in parts]
+        size = m if todo is None else todo.size
+        bits = min(_MAX_BITS, max(_MIN_BITS, int(size).bit_length() + 1))
+        shift = np.uint64(64 - bits)
+        table = np.empty(1 << bits, dtype=np.int64)
+        # pieces of _PIECE rows: the temporaries stay small enough for malloc to recycle (a block
+        # above its mmap threshold is mapped, and page-faulted, afresh each time); the hash is
+        # computed twice rather than stored
+        for s in range(0, size, _PIECE):
+            table[_hash([p[s:s + _PIECE] for p in sub], salt) >> shift] = np.arange(s, min(s + _PIECE, size))
+        left = []
+        for s in range(0, size, _PIECE):
+            piece = [p[s:s + _PIECE] for p in sub]
+            held = table[_hash(piece, salt) >> shift]  # the row that holds the bucket (any one)
+            same = np.ones(len(held), dtype=bool)
+            for p, whole in zip(piece, sub):
+                q = whole[held]  # whole rows at once: one cache line per row
+                for j in range(p.shape[1]):
+                    same &= q[:, j] == p[:, j]
+            rows = np.arange(s, s + len(held))
+            if todo is None:
+                rep[rows[same]] = held[same]
+            else:
+                rep[todo[rows[same]]] = todo[held[same]]
+            left.append(rows[~same] if todo is None else todo[rows[~same]])
+        todo = np.concatenate(left)  # these met another value in their bucket: hash them again
         salt = (salt + int(_MIX)) % 2**64
     first = np.flatnonzero(rep == np.arange(m))
     pos = np.empty(m, dtype=np.int64)

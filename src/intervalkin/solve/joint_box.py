@@ -64,6 +64,8 @@ MAX_CELLS = 64
 #: 128 KiB mmap threshold, so the many temporaries of the interval kernels are recycled by malloc
 #: instead of being mapped and page-faulted afresh (4 to 8 times slower at 65536).
 _CHUNK = 16000
+#: Rows compared together with their keys' enclosures (8 MB per gathered float array).
+_ROWS = 1 << 20
 
 #: (owner (m,), cells (m, 4) rows [theta_lo, theta_hi, phi_lo, phi_hi]).
 Cells = tuple[np.ndarray, np.ndarray]
@@ -150,12 +152,9 @@ def live_cells(geometry: Geometry, joint_boxes: np.ndarray, owner: np.ndarray, c
     del first, cells
     done_o, done_c = [], []
     for round_ in range(rounds + 1):
-        lo, hi = _key_rho_sq(geometry, key_rho1, key_cells)
-        b2l, b2h, b3l, b3h = (v[owner] for v in bounds)
-        gone = (hi[key, 0] < b2l) | (lo[key, 0] > b2h) | (hi[key, 1] < b3l) | (lo[key, 1] > b3h)
-        del b2l, b2h, b3l, b3h
-        live = np.flatnonzero(~gone)
-        gone[live] = _key_det_signed(geometry, key_rho1, key_cells, key[live])[key[live]]
+        boxes, missed = _key_rho_sq(geometry, key_rho1, key_cells)
+        gone = _rows_missed(owner, key, missed, bounds)
+        gone |= _key_det_signed(geometry, boxes, key[~gone])[key]
         owner, key = owner[~gone], key[~gone]
         stop = np.bincount(owner, minlength=n)[owner] > max_cells
         if round_ == rounds:
@@ -172,24 +171,42 @@ def live_cells(geometry: Geometry, joint_boxes: np.ndarray, owner: np.ndarray, c
     return o[order], c[order]
 
 
-def _key_rho_sq(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(lo, hi), each (K, 2): rho_2^2 and rho_3^2 over the pose box of each key."""
-    lo, hi = np.empty((len(cells), 2)), np.empty((len(cells), 2))
+def _key_rho_sq(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
+    """(pose boxes (K, 3, 2), [lo_2, hi_2, lo_3, hi_3]): each key's pose box and the bounds (K,) of
+    its enclosures of rho_2^2 and rho_3^2."""
+    boxes = np.empty((len(cells), 3, 2))
+    missed = [np.empty(len(cells)) for _ in range(4)]
     for s in range(0, len(cells), _CHUNK):
-        boxes = _pose_boxes(geometry, rho1[s:s + _CHUNK], cells[s:s + _CHUNK])
-        lo[s:s + _CHUNK], hi[s:s + _CHUNK] = _rho_sq_legs_23(geometry, boxes)
-    return lo, hi
+        boxes[s:s + _CHUNK] = b = _pose_boxes(geometry, rho1[s:s + _CHUNK], cells[s:s + _CHUNK])
+        lo, hi = _rho_sq_legs_23(geometry, b)
+        for v, w in zip(missed, (lo[:, 0], hi[:, 0], lo[:, 1], hi[:, 1])):
+            v[s:s + _CHUNK] = w
+    return boxes, missed
 
 
-def _key_det_signed(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray, used: np.ndarray) -> np.ndarray:
+def _rows_missed(owner: np.ndarray, key: np.ndarray, e: list[np.ndarray], bounds: list[np.ndarray]) -> np.ndarray:
+    """(m,) bool: the key's enclosure of rho_2^2 or rho_3^2 misses the owner's R_2^2 or R_3^2.
+
+    By pieces of _ROWS rows: the gathered temporaries stay small enough for malloc to recycle
+    them (a larger block is mapped afresh each time, and page faults cost more than the gathers)."""
+    out = np.empty(owner.size, dtype=bool)
+    lo2, hi2, lo3, hi3 = e
+    b2l, b2h, b3l, b3h = bounds
+    for s in range(0, owner.size, _ROWS):
+        o, k = owner[s:s + _ROWS], key[s:s + _ROWS]
+        out[s:s + _ROWS] = (hi2[k] < b2l[o]) | (lo2[k] > b2h[o]) | (hi3[k] < b3l[o]) | (lo3[k] > b3h[o])
+    return out
+
+
+def _key_det_signed(geometry: Geometry, boxes: np.ndarray, used: np.ndarray) -> np.ndarray:
     """(K,) bool: det A has a proved sign over the pose box of the key; evaluated for the keys in ``used`` only."""
-    out = np.zeros(len(cells), dtype=bool)
+    out = np.zeros(len(boxes), dtype=bool)
     mark = out.copy()
     mark[used] = True
     todo = np.flatnonzero(mark)
     for s in range(0, todo.size, _CHUNK):
         t = todo[s:s + _CHUNK]
-        out[t] = _det_signed(geometry, _pose_boxes(geometry, rho1[t], cells[t]))
+        out[t] = _det_signed(geometry, boxes[t])
     return out
 
 
