@@ -81,16 +81,6 @@ def _pose_boxes(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray) -> np.n
     return np.stack([np.stack([x.lo, x.hi], -1), np.stack([y.lo, y.hi], -1), cells[:, 2:4]], axis=1)
 
 
-def _rho_sq_legs_23(geometry: Geometry, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(lo, hi), each (m, 2): columns 2 and 3 of :func:`~intervalkin.kinematics.enclosures.rho_sq_interval`
-    (leg 1 is not needed: B1 is on its circle by construction)."""
-    lo, hi = np.empty((len(boxes), 2)), np.empty((len(boxes), 2))
-    for j in (1, 2):
-        e = rho_sq_leg_interval(geometry, boxes, j)
-        lo[:, j - 1], hi[:, j - 1] = e.lo, e.hi
-    return lo, hi
-
-
 def _det_signed(geometry: Geometry, boxes: np.ndarray) -> np.ndarray:
     """(m,) bool: det A has a proved sign over the box (no singular pose in it)."""
     det = det_a_interval(geometry, boxes)
@@ -152,8 +142,8 @@ def live_cells(geometry: Geometry, joint_boxes: np.ndarray, owner: np.ndarray, c
     del first, cells
     done_o, done_c = [], []
     for round_ in range(rounds + 1):
-        boxes, missed = _key_rho_sq(geometry, key_rho1, key_cells)
-        gone = _rows_missed(owner, key, missed, bounds)
+        boxes, enclosures = _key_rho_sq(geometry, key_rho1, key_cells)
+        gone = _rows_missed(owner, key, enclosures, bounds)
         gone |= _key_det_signed(geometry, boxes, key[~gone])[key]
         owner, key = owner[~gone], key[~gone]
         stop = np.bincount(owner, minlength=n)[owner] > max_cells
@@ -173,15 +163,16 @@ def live_cells(geometry: Geometry, joint_boxes: np.ndarray, owner: np.ndarray, c
 
 def _key_rho_sq(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
     """(pose boxes (K, 3, 2), [lo_2, hi_2, lo_3, hi_3]): each key's pose box and the bounds (K,) of
-    its enclosures of rho_2^2 and rho_3^2."""
+    its enclosures of rho_2^2 and rho_3^2 (:func:`~intervalkin.kinematics.enclosures.rho_sq_leg_interval`;
+    leg 1 is not needed: B1 is on its circle by construction)."""
     boxes = np.empty((len(cells), 3, 2))
-    missed = [np.empty(len(cells)) for _ in range(4)]
+    bounds = [np.empty(len(cells)) for _ in range(4)]
     for s in range(0, len(cells), _CHUNK):
         boxes[s:s + _CHUNK] = b = _pose_boxes(geometry, rho1[s:s + _CHUNK], cells[s:s + _CHUNK])
-        lo, hi = _rho_sq_legs_23(geometry, b)
-        for v, w in zip(missed, (lo[:, 0], hi[:, 0], lo[:, 1], hi[:, 1])):
-            v[s:s + _CHUNK] = w
-    return boxes, missed
+        for leg, lo, hi in ((1, *bounds[:2]), (2, *bounds[2:])):
+            e = rho_sq_leg_interval(geometry, b, leg)
+            lo[s:s + _CHUNK], hi[s:s + _CHUNK] = e.lo, e.hi
+    return boxes, bounds
 
 
 def _rows_missed(owner: np.ndarray, key: np.ndarray, e: list[np.ndarray], bounds: list[np.ndarray]) -> np.ndarray:
