@@ -31,6 +31,8 @@ from intervalkin.kinematics.formulas import (
     inverse_kinematics_arb,
     jacobian_arb,
     quadratic,
+    quadratic_gradient,
+    quadratic_with_gradient,
     rho_sq_arb,
 )
 from intervalkin.paving.predicates import pave_workspace
@@ -104,6 +106,21 @@ def test_det_formula_equals_determinant_of_jacobian(paper_geometry):
         J = jacobian_arb(paper_geometry, x, y, phi)
         d = arb_mat(J).det()
         assert abs(d - det_a_arb(paper_geometry, x, y, phi)) < 1e-20 * (1 + abs(d))
+
+
+def test_quadratic_with_gradient_is_the_two_formulas_bit_for_bit():
+    """The shared-product form gives the very floats of quadratic and quadratic_gradient (intervals)."""
+    rng = np.random.default_rng(8)
+
+    def iv(n):
+        a, b = rng.uniform(-30, 30, (2, n))
+        return Interval(np.minimum(a, b), np.maximum(a, b))
+
+    coef, X, Y = [iv(500) for _ in range(5)], iv(500), iv(500)
+    q, (gx, gy) = quadratic_with_gradient(coef, X, Y)
+    for got, want in ((q, quadratic(coef, X, Y)), (gx, quadratic_gradient(coef, X, Y)[0]),
+                      (gy, quadratic_gradient(coef, X, Y)[1])):
+        assert np.array_equal(got.lo, want.lo) and np.array_equal(got.hi, want.hi)
 
 
 def test_float_versions_agree_with_arb(paper_geometry):

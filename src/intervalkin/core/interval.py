@@ -78,8 +78,11 @@ def round_down(x: np.ndarray) -> np.ndarray:
     About ten times faster than ``np.nextafter``; +inf maps to the largest float, as nextafter does.
     """
     x = np.asarray(x, dtype=np.float64)
+    t = _ulp_bound(x)
+    if x.ndim and x.size and x.max() < _POS_INF:  # no +inf and no NaN (max is NaN then): no fix-up
+        return np.subtract(x, t, out=t)
     with np.errstate(invalid="ignore"):  # inf - inf, replaced below
-        r = np.subtract(x, _ulp_bound(x))
+        r = np.subtract(x, t)
     if r.ndim:
         np.copyto(r, _MAX, where=x == _POS_INF)
     elif x == _POS_INF:
@@ -90,8 +93,11 @@ def round_down(x: np.ndarray) -> np.ndarray:
 def round_up(x: np.ndarray) -> np.ndarray:
     """A float at least one ulp above x: an upper bound of any real within one ulp of x."""
     x = np.asarray(x, dtype=np.float64)
+    t = _ulp_bound(x)
+    if x.ndim and x.size and x.min() > _NEG_INF:  # no -inf and no NaN: no fix-up
+        return np.add(x, t, out=t)
     with np.errstate(invalid="ignore"):  # -inf + inf, replaced below
-        r = np.add(x, _ulp_bound(x))
+        r = np.add(x, t)
     if r.ndim:
         np.copyto(r, -_MAX, where=x == _NEG_INF)
     elif x == _NEG_INF:
@@ -222,11 +228,20 @@ class Interval:
         if o is None:
             return NotImplemented
         p1 = self.lo * o.lo
-        p2 = self.lo * o.hi
         p3 = self.hi * o.lo
+        if o.lo is o.hi:  # a point (a float operand): p2 = p1 and p4 = p3, so the same min and max
+            return Interval(round_down(np.minimum(p1, p3)), round_up(np.maximum(p1, p3)))
+        p2 = self.lo * o.hi
         p4 = self.hi * o.hi
-        lo = np.minimum(np.minimum(p1, p2), np.minimum(p3, p4))
-        hi = np.maximum(np.maximum(p1, p2), np.maximum(p3, p4))
+        if type(p1) is np.ndarray and p1.shape == p2.shape == p3.shape == p4.shape:
+            # the same min(min(p1, p2), min(p3, p4)) and max, with the products as scratch (fewer temporaries)
+            lo = np.minimum(p1, p2)
+            hi = np.maximum(p1, p2, out=p1)
+            np.minimum(lo, np.minimum(p3, p4, out=p2), out=lo)
+            np.maximum(hi, np.maximum(p3, p4, out=p3), out=hi)
+        else:
+            lo = np.minimum(np.minimum(p1, p2), np.minimum(p3, p4))
+            hi = np.maximum(np.maximum(p1, p2), np.maximum(p3, p4))
         return Interval(round_down(lo), round_up(hi))
 
     __rmul__ = __mul__

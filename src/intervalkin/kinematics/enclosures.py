@@ -53,7 +53,7 @@ from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.constants import KinematicConstants, constants
-from intervalkin.kinematics.formulas import det_coefficients, leg_moment, leg_rho_sq, quadratic, quadratic_gradient
+from intervalkin.kinematics.formulas import det_coefficients, leg_moment, leg_rho_sq, quadratic_gradient, quadratic_with_gradient
 
 __all__ = ['PhiDual', 'rho_sq_interval', 'rho_sq_leg_interval', 'rho_interval', 'LegForms', 'rho_sq_leg_forms',
            'jacobian_interval', 'det_a_interval', 'det_a_gradient_interval']
@@ -344,11 +344,13 @@ def _det_coefficients_over(k: KinematicConstants, ph: _PhiRanges) -> list[_OverP
     return _over_phi(ph, det_coefficients(r2x, r2y, r3x, r3y, e2x, e2y, e3x, e3y))
 
 
-def _taylor(coef, Xm: Interval, Ym: Interval, U: Interval, V: Interval) -> Interval:
-    """The quadratic over X = Xm + U, Y = Ym + V, as its exact Taylor expansion at (Xm, Ym)."""
+def _taylor(coef, Xm: Interval, Ym: Interval, U: Interval, V: Interval, UU: Interval, UV: Interval,
+            VV: Interval) -> Interval:
+    """The quadratic over X = Xm + U, Y = Ym + V, as its exact Taylor expansion at (Xm, Ym);
+    UU, UV, VV enclose U^2, U V, V^2 (computed once for the five forms of a box)."""
     a, b, c = coef[:3]
-    gx, gy = quadratic_gradient(coef, Xm, Ym)
-    return quadratic(coef, Xm, Ym) + gx * U + gy * V + a * U.sqr() + b * (U * V) + c * V.sqr()
+    q, (gx, gy) = quadratic_with_gradient(coef, Xm, Ym)
+    return q + gx * U + gy * V + a * UU + b * UV + c * VV
 
 
 def _centre_offsets(k: KinematicConstants, b: np.ndarray):
@@ -364,9 +366,10 @@ def _det_q(geometry: Geometry, b: np.ndarray):
     ph = _phi_ranges(b, DET_PHI_PIECES)
     co = _det_coefficients_over(k, ph)
     Xm, Ym, U, V = _centre_offsets(k, b)
+    squares = (U.sqr(), U * V, V.sqr())
 
     def form(name):
-        return _taylor([c.box(name) for c in co], Xm, Ym, U, V)
+        return _taylor([c.box(name) for c in co], Xm, Ym, U, V, *squares)
 
     slope = form("slope")
     q = form("value") if ph.thin else _phi_tight(form, slope, ph.offset)

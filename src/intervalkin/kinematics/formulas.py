@@ -37,7 +37,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.constants import constants
 
-__all__ = ['leg_rho_sq', 'leg_moment', 'det_coefficients', 'quadratic', 'quadratic_gradient',
+__all__ = ['leg_rho_sq', 'leg_moment', 'det_coefficients', 'quadratic', 'quadratic_gradient', 'quadratic_with_gradient',
            'approx_rho_sq', 'approx_inverse_kinematics', 'approx_det_a', 'approx_jacobian',
            'rho_sq_arb', 'inverse_kinematics_arb', 'det_a_arb', 'residual_arb', 'jacobian_arb']
 
@@ -98,6 +98,14 @@ def quadratic_gradient(coef, X, Y) -> tuple:
     """(d/dX, d/dY) of :func:`quadratic`: (2 a X + b Y + d, b X + 2 c Y + e)."""
     a, b, c, d, e = coef
     return (a * X) * 2.0 + b * Y + d, b * X + (c * Y) * 2.0 + e
+
+
+def quadratic_with_gradient(coef, X, Y) -> tuple:
+    """(:func:`quadratic`, :func:`quadratic_gradient`) with their common products a X, b Y, c Y
+    computed once: the same operations in the same order, so bit for bit the same results."""
+    a, b, c, d, e = coef
+    aX, bY, cY = a * X, b * Y, c * Y
+    return X * (aX + bY + d) + Y * (cY + e), (aX * 2.0 + bY + d, b * X + cY * 2.0 + e)
 
 
 def _legs(base, rotation, x, y, phi) -> list[tuple]:
