@@ -1,6 +1,7 @@
 """Benchmark of the direct joint-space paving (a script, not a test).
 
-    python benchmarks/bench_joint_paving.py [--depths 5 6 7] [--geometry FILE] [--samples 2000] [--fold] [--face-levels 3]
+    python benchmarks/bench_joint_paving.py [--depths 6 7] [--geometry FILE] [--samples 2000] [--no-fold]
+        [--model-levels 1] [--face-levels 3]
 
 Per depth: boxes, wall time, peak memory (resident set of this process), the share of
 the joint box's volume in boxes certified off g(S), the cells (count: number), the
@@ -8,8 +9,10 @@ basic regions they imply (the sum of the cells' counts, Theorem 1), and the agre
 of the paving with independent certified solves at random joint vectors: labelled
 (the vector lies in a cell, or in a piece of a fold box placed by the side test),
 agreeing (the cell's count and aspect split equal the solve's) and wrong (must be 0:
-a wrong label is a soundness bug).  ``--fold`` adds the fold models and prints their
-number and the fold pieces joined to no cell.
+a wrong label is a soundness bug).  Local models are on by default (``--no-fold``: the
+clear-box test alone): the boxes cleared by Krawczyk exclusion, the fold boxes, the fold
+pieces joined to no cell and the fragments are printed.  With two depths or more, the
+cells of each depth are compared with the first's, witness by witness.
 
 Issue 13's targets: >= 99 % of the volume certified, random vectors labelled and
 agreeing >= 99 %, 0 wrong, <= 60 s and <= 2 GiB at the default settings on 2 cores.
@@ -35,7 +38,7 @@ def _agreement(geometry, jp, samples: int, seed: int) -> tuple[int, int, int, in
     rng = np.random.default_rng(seed)
     q = dom[:, 0] + rng.random((samples, 3)) * (dom[:, 1] - dom[:, 0])
     cell = jp.cell_of(q, geometry)
-    by_id = {c.id: c for c in jp.cells}
+    by_id = {c.id: c for c in jp.cells + jp.fragments}
     labelled = agree = wrong = 0
     for v, cid in zip(q, cell):
         if cid < 0:
@@ -52,20 +55,37 @@ def _agreement(geometry, jp, samples: int, seed: int) -> tuple[int, int, int, in
     return samples, labelled, agree, wrong
 
 
+def _compare(geometry, a, b) -> str:
+    """Whether paving b has the cells of paving a: same signatures, each witness of a in a cell of b of its signature."""
+    same = sorted(c.signature for c in a.cells) == sorted(c.signature for c in b.cells)
+    by_id = {c.id: c for c in b.cells}
+    hits = set()
+    for c in a.cells:
+        cid = int(b.cell_of(np.array([[float(v) for v in c.witness]]), geometry)[0])
+        if cid in by_id and by_id[cid].signature == c.signature:
+            hits.add(cid)
+    ok = same and len(hits) == len(a.cells)
+    return (f"against the first depth: {'the same cells' if ok else 'DIFFERENT cells'} (signatures "
+            f"{'equal' if same else 'differ'}, {len(hits)} of {len(a.cells)} witnesses in distinct cells of their signature)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--depths", type=int, nargs="+", default=[DEFAULT_JOINT_DEPTH])
     ap.add_argument("--geometry", default=None)
     ap.add_argument("--samples", type=int, default=1000, help="random joint vectors checked by certified solves")
-    ap.add_argument("--fold", action="store_true", help="give undecided boxes fold models (solve.fold_model)")
+    ap.add_argument("--no-fold", action="store_true", help="no local models: the clear-box test alone")
+    ap.add_argument("--model-levels", type=int, default=None, help="levels of local refinement (default: the library's)")
     ap.add_argument("--face-levels", type=int, default=0, help="further levels for undecided boxes on the faces")
     args = ap.parse_args()
     g = default_geometry() if args.geometry is None else load_geometry(args.geometry)
     print(f"{'depth':>5} {'boxes':>9} {'seconds':>8} {'peak MB':>8} {'certified':>9} {'regions':>7} "
           f"{'labelled':>8} {'agree':>6} {'wrong':>5}   cells (count: number)")
+    first = None
+    extra = {} if args.model_levels is None else {"model_levels": args.model_levels}
     for depth in args.depths:
         t0 = time.perf_counter()
-        jp = pave_joint_space(g, depth, fold=args.fold, face_levels=args.face_levels)
+        jp = pave_joint_space(g, depth, fold=not args.no_fold, face_levels=args.face_levels, **extra)
         dt = time.perf_counter() - t0
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
         n, labelled, agree, wrong = _agreement(g, jp, args.samples, seed=depth)
@@ -75,11 +95,19 @@ def main() -> None:
               f"{sum(c.count for c in jp.cells):>7} {100 * labelled / n:>7.1f}% {100 * agree / n:>5.1f}% {wrong:>5}   {cells}",
               flush=True)
         if jp.fold_stats:
-            print(f"       fold boxes {jp.fold_stats['fold_boxes']} ({jp.fold_stats['seconds']:.1f} s); pieces joined to "
-                  f"no cell: {jp.fold_stats['unjoined_piece_groups']} groups, volume "
-                  f"{jp.fold_stats['unjoined_piece_volume']:.2f}", flush=True)
-        print("       undecided volume per level: " + ", ".join(
-            f"{st['level']}: {st['undecided_volume']['clear']:.0f}" for st in jp.paving.stats), flush=True)
+            fs = jp.fold_stats
+            print(f"       cleared by exclusion {fs['void_boxes']} boxes (volume {fs['void_volume']:.0f}); fold boxes "
+                  f"{fs['fold_boxes']} ({fs['seconds']:.1f} s for their pieces); pieces joined to no cell: "
+                  f"{fs['unjoined_piece_groups']} groups, volume {fs['unjoined_piece_volume']:.2f}; fragments "
+                  f"{len(jp.fragments)} (volume {sum(c.volume for c in jp.fragments):.3f})", flush=True)
+        print("       undecided volume per stage: " + ", ".join(
+            f"{st['stage']} {st['level']}: {st['undecided_volume']['clear']:.0f}" for st in jp.paving.stats), flush=True)
+        print("       cells: " + "; ".join(f"{c.count} ({c.n_wa1}+{c.n_wa2}) vol {c.volume:.2f} at "
+                                          f"({', '.join(f'{float(v):.2f}' for v in c.witness)})" for c in jp.cells))
+        if first is None:
+            first = jp
+        else:
+            print("       " + _compare(g, first, jp), flush=True)
     print("peak MB is the process's maximum resident set so far (it includes the earlier depths).")
 
 

@@ -193,12 +193,22 @@ def chain_table(summary: dict) -> str:
         f"{'uniqueness domains':<22}{summary['uniqueness_domains']['count']:>7}   {status(summary['uniqueness_domains'])}"
         + ("  (minimal)" if summary["uniqueness_domains"].get("minimal") else ""),
     ]
-    cells = [c for c in summary["joint"]["cells"] if c["count"] > 0 and c["voxels"] > 1]
-    by = {}
-    for c in cells:
-        by.setdefault(c["count"], []).append(c["share"])
-    rows.append("joint cells (count: number, share of the joint box): "
-                + ", ".join(f"{k}: {len(v)} ({100 * sum(v):.1f}%)" for k, v in sorted(by.items())))
+    direct = summary.get("joint_cells")
+    if direct:  # the direct joint paving: the cells the basic regions are counted over
+        by = {}
+        for c in direct["cells"]:
+            by.setdefault(c["count"], []).append(c["volume"])
+        frag = len(direct.get("fragments", []))
+        rows.append(f"joint cells (count: number; {100 * direct['certified_share']:.1f}% of the joint box certified): "
+                    + ", ".join(f"{k}: {len(v)}" for k, v in sorted(by.items()))
+                    + (f"; {frag} fragments listed apart" if frag else ""))
+    else:
+        cells = [c for c in summary["joint"]["cells"] if c["count"] > 0 and c["voxels"] > 1]
+        by = {}
+        for c in cells:
+            by.setdefault(c["count"], []).append(c["share"])
+        rows.append("joint cells (count: number, share of the joint box): "
+                    + ", ".join(f"{k}: {len(v)} ({100 * sum(v):.1f}%)" for k, v in sorted(by.items())))
     u = summary["undecided_volume"]
     rows.append(f"undecided volume: W {u['W']:.1f}, WA1 {u['WA1']:.1f}, WA2 {u['WA2']:.1f}; "
                 f"depth {summary['depth']['workspace']} (singular {summary['depth']['singular_layer']}, "

@@ -28,7 +28,7 @@ ValueError: count: found 2 is below the certified lower bound 3
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 __all__ = ["Status", "Count"]
 
@@ -57,6 +57,8 @@ class Count:
         True exactly when ``lower == upper`` (then ``found`` is the true number).
     why : str
         What backs the bounds, and what is missing for an exact count.
+    undecided : dict
+        Where the bounds could not be closed (volumes, boxes, places); empty when nothing is said.
     """
 
     found: int
@@ -64,6 +66,8 @@ class Count:
     upper: int | None
     exact: bool
     why: str
+    #: what keeps the bounds apart: where and how much is undecided (empty when nothing is said)
+    undecided: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for name in ("found", "lower", "upper"):
@@ -89,4 +93,6 @@ class Count:
     def to_json(self) -> dict:
         """The summary.json block: ``count``, ``exact``, ``lower_bound``, ``upper_bound`` (null: none proved), ``why``."""
         return {"count": self.found, "exact": self.exact, "lower_bound": self.lower,
-                "upper_bound": self.upper, "why": self.why}
+                "upper_bound": self.upper, "why": self.why,
+                # issue 14's names for the same numbers
+                "found": self.found, "lower": self.lower, "upper": self.upper, "undecided": dict(self.undecided)}

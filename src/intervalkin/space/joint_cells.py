@@ -251,7 +251,7 @@ def joining_paths(edges: np.ndarray, cell: np.ndarray, cells: list[JointSpaceCel
     return out
 
 
-def regions_from_cells(cells: Sequence[JointSpaceCell], proved_lower: int = 0) -> Count:
+def regions_from_cells(cells: Sequence[JointSpaceCell], proved_lower: int = 0, undecided: dict | None = None) -> Count:
     """The basic regions implied by the joint cells (Theorem 1), as a :class:`Count`.
 
     Above a component C of (joint box minus g(S)) whose points have n_wa1 + n_wa2
@@ -276,7 +276,8 @@ def regions_from_cells(cells: Sequence[JointSpaceCell], proved_lower: int = 0) -
         f"(cells by solutions: {tally}); at least {lower} are proved by the certified witnesses (distinct "
         "solutions and aspect splits, Theorem 1); two cells of one signature may still be one component "
         "joined through undecided boxes, and small cells may hide in them, so no upper bound is proved"
-        + (f"; {unknown} cells whose solve did not complete are not counted" if unknown else ""))
+        + (f"; {unknown} cells whose solve did not complete are not counted" if unknown else ""),
+        dict(undecided or {}))
 
 
 def _tally(cells: Sequence[JointSpaceCell]) -> dict[int, int]:

@@ -1,0 +1,69 @@
+"""The report's passage on the direct joint paving: the count of basic regions explained cell by cell.
+
+Written from ``summary.json``'s ``joint_cells`` block alone (:func:`intervalkin.app.summary.joint_cells_summary`),
+so what the report says is exactly what the summary states.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+__all__ = ["joint_cells_passage"]
+
+_FACE = 0.5  # a witness this close to a limit is said to lie "along" that face
+
+
+def _where(witness: list[float], lo: list[float], hi: list[float]) -> str:
+    near = [f"rho_{i + 1} = {lo[i]:g}" for i in range(3) if witness[i] - lo[i] < _FACE]
+    near += [f"rho_{i + 1} = {hi[i]:g}" for i in range(3) if hi[i] - witness[i] < _FACE]
+    return "along " + " and ".join(near) if near else "inside"
+
+
+def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) -> list[str]:
+    """Markdown lines: the cells of the direct joint paving, their counts, and the sum that is the count of basic regions.
+
+    ``limits``: (rho_min, rho_max) per leg, to say which cells hug a face of the joint box.
+    """
+    jc = summary.get("joint_cells")
+    if not jc:
+        return []
+    lo, hi = limits
+    br = summary.get("basic_regions", {})
+    out = ["## The joint box paved directly: the count of basic regions, cell by cell\n",
+           f"The joint box is paved to depth {jc['depth']} (leaves down to level {jc['deepest_level']}, "
+           f"{jc['boxes']} boxes). A box is certified when it is proved off g(S) (no singular pose has its joint "
+           "vector in it: by the search on the circle of leg 1, or by Krawczyk exclusion: "
+           f"{jc['boxes_cleared_by_exclusion']['boxes']} boxes) or when one sheet of g(S) crosses it as a proved "
+           f"graph and both of its pieces are counted ({jc['fold_boxes']} fold boxes). Certified: "
+           f"{100 * jc['certified_share']:.1f}% of the joint box; undecided volume {jc['undecided_volume']:.1f}.\n",
+           "A cell is a connected set of certified boxes and pieces; one complete certified solve at its witness "
+           "gives its count and aspect split, which hold at every point of the cell. Above a cell with n "
+           "solutions lie n basic regions, n/2 in each aspect (Theorem 1 and Proposition 1), so the count of "
+           "basic regions is the sum of the cells' counts:\n",
+           "| cell | solutions | WA1 | WA2 | volume | witness (rho_1, rho_2, rho_3) | where |",
+           "|---|---|---|---|---|---|---|"]
+    for c in jc["cells"]:
+        w = [float(Fraction(v)) for v in c["witness"]]
+        cnt = str(c["count"]) if c["count"] >= 0 else "?"
+        out.append(f"| {c['id']} | {cnt} | {c['n_wa1']} | {c['n_wa2']} | {c['volume']:.2f} | "
+                   f"({', '.join(f'{v:.3f}' for v in w)}) | {_where(w, lo, hi)} |")
+    counts = [c["count"] for c in jc["cells"] if c["count"] >= 0]
+    terms = " + ".join(str(n) for n in sorted(counts, reverse=True))
+    lower = br.get("lower")
+    out.append(f"\nSum: {terms} = {sum(counts)} basic regions found"
+               + (f" (proved lower bound {lower}" if lower is not None else " (")
+               + (f", upper bound {br['upper']})" if br.get("upper") is not None else "; no upper bound is proved)")
+               + ". Cells with equal counts are not yet proved to be different components of the joint box "
+               "minus g(S), and undecided boxes could still join two of them or hide a small one.\n")
+    frags = jc.get("fragments") or []
+    if frags:
+        out.append(f"{len(frags)} fragments (certified islands inside the undecided layer, made only by the local "
+                   "refinement and joined to no cell; each lies in some component, perhaps one of the cells "
+                   "above) are listed apart and not counted: "
+                   + ", ".join(f"{f['count']} solutions at ({', '.join(f'{float(Fraction(v)):.2f}' for v in f['witness'])})"
+                               for f in frags[:8]) + (" ..." if len(frags) > 8 else "") + ".\n")
+    ufp = jc.get("unjoined_fold_pieces") or {}
+    if ufp.get("groups"):
+        out.append(f"Fold pieces joined to no cell: {ufp['groups']} groups, volume {ufp['volume']:.2f} "
+                   "(counted as undecided).\n")
+    return out
