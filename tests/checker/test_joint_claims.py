@@ -382,3 +382,28 @@ def test_side_test_agrees_with_the_library_and_with_solves(paper_geometry, fold_
                 assert res.complete and res.count == wit_count[mine], (q, mine, res.count, wit_count)
                 counted += 1
     assert agreed >= 30 and counted >= 15
+
+
+def test_component_joins_link_clear_components(paper_geometry):
+    """Without join levels, at depth 6, one cell of the paper's manipulator is three face-connected groups of
+    clear boxes that only fold pieces join: the two component joins come first, end in clear boxes of two
+    different groups, and verify (about 15 s: the depth-6 paving)."""
+    from intervalkin.certify.joint_claims import joint_claims
+    from intervalkin.paving.adjacency import component_labels, shares_face
+    from intervalkin.space.joint_paving import pave_joint_space
+
+    jsp = pave_joint_space(paper_geometry, 6, 0, fold=True)
+    models, joins, omitted = joint_claims(paper_geometry, jsp, max_joins=2, max_models=8)
+    assert len(joins) == 2 and "2 joining clear components" in omitted[-1]["what"]
+    pav = jsp.paving
+    clear = jsp.cell >= 0
+    comp = component_labels(len(pav), shares_face(pav.level, pav.ijk, int(pav.level.max()), (False,) * 3), clear)
+    leaf_of = {tuple((float(a), float(b)) for a, b in zip(pav.lo[i], pav.hi[i])): i for i in np.flatnonzero(clear)}
+    facts = {f"{MODELS}#{c['id']}": run_check(paper_geometry, "joint_fold_model", c, 128)[1] for c in models}
+    for j in joins:
+        ends = [j["nodes"][0], j["nodes"][-1]]
+        assert all("clear" in n for n in ends)
+        leaves = [leaf_of[tuple((float(a), float(b)) for a, b in read_joint_box(n["clear"]))] for n in ends]
+        assert jsp.cell[leaves[0]] == jsp.cell[leaves[1]] and comp[leaves[0]] != comp[leaves[1]]
+        ok, why = check_claim(paper_geometry, "joint_join", j, j["precision"], verified=facts)
+        assert ok, why

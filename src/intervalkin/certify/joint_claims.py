@@ -29,6 +29,7 @@ reason.  Every claim is run through the checker before it is written.
 
 from __future__ import annotations
 
+import itertools
 from fractions import Fraction
 
 import numpy as np
@@ -51,6 +52,8 @@ __all__ = ["MAX_JOINS", "MAX_MODELS", "joint_claims"]
 MAX_JOINS = 64
 #: Fold models written at most (those the joins use).
 MAX_MODELS = 64
+#: Plans passed over for want of room for their fold models before the search for joins stops.
+SCAN_PAST_CAP = 5000
 #: Points tried on a shared face, as fractions of its two sides (the paving's own choice, re-made here).
 FACE_FRACTIONS = ((0.5, 0.5), (0.1, 0.1), (0.1, 0.9), (0.9, 0.1), (0.9, 0.9), (0.3, 0.7), (0.7, 0.3))
 _CRITERIA = ({"name": "height_inside"}, {"name": "normal_signs"})
@@ -88,11 +91,15 @@ class _Graph:
         self.orig = e[:, keep]
         u, v = self.node(self.orig[0]), self.node(self.orig[1])
         self.size = self.ncomp + 2 * len(self.pieces)
-        self.edge_of = {}
-        for a, b, k in zip(u.tolist(), v.tolist(), range(u.size)):
-            self.edge_of.setdefault((a, b), k)
-            self.edge_of.setdefault((b, a), k)
         self.u, self.v = u, v
+        keys = np.concatenate([u * (self.size + 1) + v, v * (self.size + 1) + u])
+        self._order = np.argsort(keys, kind="stable")
+        self._keys = keys[self._order]
+
+    def edge_of(self, a: int, b: int) -> int:
+        """An original edge (column of ``orig``) between graph nodes a and b."""
+        at = int(np.searchsorted(self._keys, a * (self.size + 1) + b))
+        return int(self._order[at]) % self.u.size
 
     def node(self, v: np.ndarray) -> np.ndarray:
         v = np.asarray(v, dtype=np.int64)
@@ -101,14 +108,19 @@ class _Graph:
     def leaf(self, orig: int) -> int:
         return orig if orig < self.n else int(self.pieces.box[(orig - self.n) // 2])
 
-    def bfs(self, sources: list[int]) -> np.ndarray:
-        """Predecessors of a breadth-first search from the given nodes (a virtual root joins them)."""
+    def bfs(self, sources: list[int]) -> tuple[np.ndarray, np.ndarray]:
+        """(predecessors, distances; -1 where not reached) of a breadth-first search from the given nodes
+        (a virtual root joins them: the sources are at distance 1)."""
         root = self.size
         u = np.concatenate([self.u, np.full(len(sources), root)])
         v = np.concatenate([self.v, np.asarray(sources, dtype=np.int64)])
         g = csr_matrix((np.ones(u.size), (u, v)), shape=(root + 1, root + 1))
-        _, pred = breadth_first_order(g, root, directed=False, return_predecessors=True)
-        return pred
+        order, pred = breadth_first_order(g, root, directed=False, return_predecessors=True)
+        dist = np.full(root + 1, -1, dtype=np.int64)
+        dist[root] = 0
+        for node in order[1:].tolist():
+            dist[node] = dist[pred[node]] + 1
+        return pred, dist
 
     def path_to(self, pred: np.ndarray, target: int) -> list[int] | None:
         """Nodes from the last component on the search path to ``target`` (None: not reached)."""
@@ -206,7 +218,7 @@ class _Writer:
         g = self.g
         orig = []  # original nodes: leaf index of a clear box, or n + piece
         for s in range(len(path) - 1):
-            k = g.edge_of[(path[s], path[s + 1])]
+            k = g.edge_of(path[s], path[s + 1])
             a, b = (int(v) for v in g.orig[:, k])
             if g.node(np.array([a]))[0] != path[s]:
                 a, b = b, a
@@ -274,39 +286,46 @@ def joint_claims(geometry: Geometry, jsp, precision: int = 128, max_joins: int =
         if comps.size < 2:
             continue
         root = int(comps[np.argmax(g.comp_size[comps])])
-        pred = g.bfs([root])
+        pred, _ = g.bfs([root])
         for c in comps:
             if c != root:
                 path = g.path_to(pred, int(c))
                 if path is not None:
                     plans.append((path, None, f"clear components of cell {cell}"))
     n_component = len(plans)
-    # 2. piece joins: both pieces of a fold box, shortest chains first
-    pred = g.bfs(list(range(g.ncomp)))
-    boxes = []
-    for t in range(len(g.pieces)):
-        paths = [g.path_to(pred, g.ncomp + 2 * t + s) for s in (0, 1)]
-        if all(p is not None for p in paths) and all(np.isfinite(g.pieces.witness[2 * t + s]).all() for s in (0, 1)):
-            boxes.append((max(len(p) for p in paths), t, paths))
-    boxes.sort(key=lambda x: (x[0], x[1]))
-    for _, t, paths in boxes:
-        for s, p in enumerate(paths):
-            plans.append((p, g.n + 2 * t + s, f"piece {'below' if s == 0 else 'above'} of fold box "
-                                              f"{int(g.pieces.box[t])}"))
-    joins, omitted, skipped = [], [], 0
-    for path, target, what in plans:
+    # 2. piece joins: both pieces of a fold box, shortest chains first (expanded lazily: there may be 10^5)
+    pred, dist = g.bfs(list(range(g.ncomp)))
+    m = len(g.pieces)
+    d = dist[g.ncomp:g.ncomp + 2 * m].reshape(m, 2)
+    ok = (d > 0).all(axis=1) & np.isfinite(g.pieces.witness).all(axis=1).reshape(m, 2).all(axis=1)
+    boxes = np.flatnonzero(ok)
+    boxes = boxes[np.lexsort((boxes, d[boxes].max(axis=1)))]
+
+    def piece_plans():
+        for t in boxes.tolist():
+            for s in (0, 1):
+                yield (g.path_to(pred, g.ncomp + 2 * t + s), g.n + 2 * t + s,
+                       f"piece {'below' if s == 0 else 'above'} of fold box {int(g.pieces.box[t])}")
+
+    total = n_component + 2 * boxes.size
+    joins, omitted, tried, capped = [], [], 0, 0
+    for path, target, what in itertools.chain(plans, piece_plans()):
+        if len(joins) >= max_joins or capped > SCAN_PAST_CAP:
+            break
+        tried += 1
         need = {(v - g.ncomp) // 2 for v in path if v >= g.ncomp} | (
             set() if target is None else {(target - g.n) // 2})
-        if len(joins) >= max_joins or len(set(w.models) | need) > max_models:
-            skipped += 1
+        if len(set(w.models) | need) > max_models:
+            capped += 1
             continue
         claim, why = w.join(path, target)
         if claim is None:
             omitted.append({"what": f"joint_join ({what})", "why": why})
         else:
             joins.append({"id": f"join-{len(joins)}", **claim})
+    skipped = total - tried + capped
     if skipped:
-        omitted.append({"what": f"joint_join: {skipped} of {len(plans)} joins ({n_component} joining clear "
+        omitted.append({"what": f"joint_join: {skipped} of {total} joins ({n_component} joining clear "
                                 "components, the rest fold pieces to their cells)",
                         "why": f"cap: at most {max_joins} joins and {max_models} fold models are written (the time "
                                "of intervalkin verify)"})
