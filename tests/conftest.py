@@ -58,3 +58,12 @@ def aspect_topology(paper_geometry):
     from intervalkin.space.aspect_topology import prove_aspects
 
     return prove_aspects(paper_geometry)
+
+
+@pytest.fixture(scope="session")
+def fold_paving(paper_geometry):
+    """The joint box paved directly with fold models, depth 5 and one join level (about 3 s): the source
+    of the ``joint_fold_model`` and ``joint_join`` claims in tests/certify and tests/checker."""
+    from intervalkin.space.joint_paving import pave_joint_space
+
+    return pave_joint_space(paper_geometry, 5, 1, fold=True)

@@ -232,7 +232,7 @@ class Analysis:
         """
         return write_certificates(folder, self.geometry, dkp_results=dkp_results, joint=self.joint,
                                   regions=self.regions, trajectories=trajectories, counts=self.counts(),
-                                  aspect_topology=self.aspect_topology)
+                                  aspect_topology=self.aspect_topology, joint_cells=self.cells)
 
 
 @dataclass(frozen=True)

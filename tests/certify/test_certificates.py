@@ -51,24 +51,26 @@ def paths(paper_geometry):
 
 
 @pytest.fixture(scope="module")
-def cert_dir(tmp_path_factory, paper_geometry, chain, table1, paths, aspect_topology):
+def cert_dir(tmp_path_factory, paper_geometry, chain, table1, paths, aspect_topology, fold_paving):
     jp, ra = chain
     out = tmp_path_factory.mktemp("certificates")
     write_certificates(out, paper_geometry, dkp_results=[table1], joint=jp, regions=ra, box_sample=120, seed=7,
-                       trajectories=paths, aspect_topology=aspect_topology)
+                       trajectories=paths, aspect_topology=aspect_topology, joint_cells=fold_paving)
     return out
 
 
 def _copy(src: Path, tmp_path: Path) -> Path:
-    """A copy to tamper with, without the aspect covers (tests/checker/test_aspects.py tampers with those;
-    re-proving their boxes in every verify here would cost seconds each): the aspects count in it goes
+    """A copy to tamper with, without the aspect covers and the joint models and joins
+    (tests/checker/test_aspects.py and tests/checker/test_joint_claims.py tamper with those;
+    re-proving them in every verify here would cost seconds each): the aspects count in it goes
     back to its lower bound, which the remaining claims prove."""
     dst = tmp_path / "copy"
     shutil.copytree(src, dst)
     index = _load(dst, "index.json")
-    index["files"].remove("aspect_connected.json")
+    for name in ("aspect_connected.json", "joint_fold_model.json", "joint_join.json"):
+        index["files"].remove(name)
+        (dst / name).unlink()
     _save(dst, "index.json", index)
-    (dst / "aspect_connected.json").unlink()
     counts = _load(dst, "counts.json")
     for c in counts["claims"]:
         if c["name"] == "aspects":

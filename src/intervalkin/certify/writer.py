@@ -85,6 +85,26 @@ Claim fields by kind (``id`` is unique within its file):
     OUT and SINK rows first, then retracting rows so that every box across an
     exit face comes earlier (:mod:`intervalkin.certify.aspect_claims`).  Proves:
     the aspect's part of W is nonempty and connected (checker.aspects).
+``joint_fold_model``
+    one claim per fold box (id ``"fold-<leaf>"``): ``box`` (the joint box, three
+    ``[lo, hi]`` pairs of exact strings), ``axis`` (k, 0-based: the sheet is a graph
+    q_k = h(q_i, q_j)), ``pose`` (the pose box X, binary64 as for dkp boxes),
+    ``criterion`` (``{"name": "height_inside" | "normal_signs"}`` or ``{"name":
+    "edge_heights", "along": b}``) and ``witnesses`` (``{"below": q, "above": q}``, exact
+    joint vectors, either optional).  Proves: X holds every singular pose whose joint vector
+    is in the box (up to 2 pi in phi), the parametric Krawczyk image of X over the box's
+    (r_i, r_j) lies in its interior, and the criterion holds: g(S) meets the box in one
+    graph sheet cutting it into two connected pieces; each witness lies on its side
+    (:mod:`intervalkin.certify.joint_claims`, :mod:`intervalkin.checker.joint_models`).
+``joint_join``
+    ``cells`` (the library's cell ids of the two ends, for the reader), ``ends`` (two
+    objects ``{"witness", "count", "n_wa1", "n_wa2", "phi0", "solutions"}`` as in a
+    joint_cell claim), ``nodes`` (``{"clear": joint box}`` or ``{"fold": "<id of a
+    joint_fold_model claim>", "side": -1 | 1}``, below or above its sheet) and ``links``
+    (one exact joint vector between consecutive nodes).  Proves: both witnesses have the
+    declared count and split and lie in one component of the open joint box minus g(S):
+    each clear node is re-proved off g(S), each link lies in both its nodes
+    (:mod:`intervalkin.checker.joint_join`).
 ``counts``
     one claim per count: ``name`` (``aspects``, ``basic_regions``,
     ``uniqueness_domains``), ``lower_bound``, ``upper_bound`` (null: none
@@ -104,6 +124,7 @@ from pathlib import Path
 from typing import Sequence
 
 from intervalkin.certify.aspect_claims import aspect_connected_claims
+from intervalkin.certify.joint_claims import joint_claims
 from intervalkin.certify.solve_claims import (
     dkp_claim,
     joint_cell_claims,
@@ -138,6 +159,7 @@ def write_certificates(
     trajectories: Sequence = (),
     counts=None,
     aspect_topology=None,
+    joint_cells=None,
 ) -> list[Path]:
     """Write the certificate folder of the given results; return the paths written (index last).
 
@@ -164,6 +186,9 @@ def write_certificates(
         ``aspect_connected.json`` (one claim per sign whose cover closed).  These claims are
         large (tens of thousands of boxes, several seconds of arb) and are written without the
         pre-check: ``intervalkin verify`` re-proves them.
+    joint_cells : :class:`~intervalkin.space.joint_paving.JointSpacePaving` -> ``joint_fold_model.json``
+        and ``joint_join.json`` when it has fold pieces (a capped selection, each claim checked
+        first: :mod:`~intervalkin.certify.joint_claims`).
 
     Every solve claim is re-checked with :mod:`intervalkin.checker` before it
     is written; refused ones are listed under ``omitted`` in ``index.json``.
@@ -206,6 +231,13 @@ def write_certificates(
         conn, om = aspect_connected_claims(aspect_topology)
         omitted += om
         files["aspect_connected"] = conn
+    if joint_cells is not None:
+        models, joins, om = joint_claims(geometry, joint_cells, precision)
+        omitted += om
+        if models:
+            files["joint_fold_model"] = models
+        if joins:
+            files["joint_join"] = joins
     if regions is not None:
         aspect_refs = [f"aspect_distinct.json#{c['id']}" for c in files.get("aspect_distinct", [])]
         aspect_refs += [f"aspect_connected.json#{c['id']}" for c in files.get("aspect_connected", [])]

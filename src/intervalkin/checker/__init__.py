@@ -28,7 +28,9 @@ Modules: :mod:`~intervalkin.checker.parse` (reading fields exactly),
 :mod:`~intervalkin.checker.model` (the arb model), :mod:`~intervalkin.checker.labels`
 (box labels), :mod:`~intervalkin.checker.solutions` (direct kinematics),
 :mod:`~intervalkin.checker.aspects` and :mod:`~intervalkin.checker.taylor` (aspect covers),
-:mod:`~intervalkin.checker.trajectory` (motions), :mod:`~intervalkin.checker.claims`
+:mod:`~intervalkin.checker.trajectory` (motions), :mod:`~intervalkin.checker.joint_torus`,
+:mod:`~intervalkin.checker.joint_models` and :mod:`~intervalkin.checker.joint_join` (fold models
+and joins of the joint paving), :mod:`~intervalkin.checker.claims`
 (one check per kind, counts), :mod:`~intervalkin.checker.consistency` (counts against
 their proofs and the summary), :mod:`~intervalkin.checker.folder` (a whole folder).
 
@@ -81,6 +83,19 @@ Re-proved per claim type
     is re-proved in arb (:mod:`~intervalkin.checker.aspects`, Taylor forms of
     :mod:`~intervalkin.checker.taylor`): that sign's part of W is nonempty and
     connected (proofs/lemma-aspect-retraction.md).
+``joint_fold_model``
+    Every singular pose whose joint vector lies in the joint box has a 2 pi-translate in
+    the pose box (torus search over (theta, phi) on the circle of leg 1); the parametric
+    Krawczyk image of the pose box over the box's (r_i, r_j) lies in its interior (the
+    checker's own preconditioner); the stated connectivity criterion holds; each witness
+    lies on its stated side of the sheet: one graph sheet of g(S) cutting the box into
+    two connected pieces (proofs/lemma-joint-claims.md).
+``joint_join``
+    The two ends declare one count and split, and each witness's complete solution list
+    proves it; every clear node is re-proved off g(S) by the torus search, every fold
+    node is a verified ``joint_fold_model`` claim of the folder; each witness and link
+    lies strictly inside the joint limits and in its node(s) (the side test for pieces):
+    both witnesses lie in one component of the joint box minus g(S).
 ``counts``
     Each declared lower bound is recomputed from the referenced claims that
     verified (rules in :func:`~intervalkin.checker.claims.count_bound`); a

@@ -19,6 +19,8 @@ from flint import ctx
 
 from intervalkin.checker.aspects import check_aspect_connected
 from intervalkin.checker.consistency import check_found, check_summary_block
+from intervalkin.checker.joint_join import check_joint_join
+from intervalkin.checker.joint_models import check_joint_fold_model
 from intervalkin.checker.labels import (
     det_negative,
     det_positive,
@@ -43,7 +45,7 @@ from intervalkin.checker.solutions import check_solutions
 from intervalkin.checker.trajectory import check_trajectory
 from intervalkin.core.geometry import Geometry
 
-__all__ = ['CHECKS', 'MALFORMED', 'check_claim', 'run_check', 'malformed_message', 'check_count', 'count_bound',
+__all__ = ['CHECKS', 'SUPPORTED_CHECKS', 'MALFORMED', 'check_claim', 'run_check', 'malformed_message', 'check_count', 'count_bound',
            'count_upper']
 
 #: Errors that mean a field had an unexpected type or value: the claim is malformed (refused, not crashed on).
@@ -188,17 +190,26 @@ CHECKS = {
     "box_labels": _check_box_labels,
     "trajectory": check_trajectory,
     "aspect_connected": check_aspect_connected,
+    "joint_fold_model": check_joint_fold_model,
+}
+#: Checks that also lean on claims verified before them ("file#id" -> facts): a join on its fold models.
+SUPPORTED_CHECKS = {
+    "joint_join": check_joint_join,
 }
 
 
-def run_check(geometry: Geometry, kind: str, claim: dict, precision: int) -> tuple[str, dict]:
+def run_check(geometry: Geometry, kind: str, claim: dict, precision: int,
+              verified: dict | None = None) -> tuple[str, dict]:
     """(statement, facts) of one claim of a kind other than ``counts``, at its own precision.
 
-    The claim's ``precision`` field, if any, overrides ``precision``.  Raises
-    :class:`Refused` or one of :data:`MALFORMED`.
+    The claim's ``precision`` field, if any, overrides ``precision``.  ``verified`` ("file#id" ->
+    facts of the claims verified so far) is what a kind of :data:`SUPPORTED_CHECKS` may lean on.
+    Raises :class:`Refused` or one of :data:`MALFORMED`.
     """
     prec = read_int(claim.get("precision", precision), "precision", *PREC_RANGE)
     with ctx.workprec(prec):
+        if kind in SUPPORTED_CHECKS:
+            return SUPPORTED_CHECKS[kind](ArbModel(geometry), claim, prec, verified or {})
         return CHECKS[kind](ArbModel(geometry), claim, prec)
 
 
@@ -207,16 +218,18 @@ def malformed_message(exc: BaseException) -> str:
     return f"malformed claim ({type(exc).__name__}: {exc})"
 
 
-def check_claim(geometry: Geometry, kind: str, claim: dict, precision: int = 128) -> tuple[bool, str]:
+def check_claim(geometry: Geometry, kind: str, claim: dict, precision: int = 128,
+                verified: dict | None = None) -> tuple[bool, str]:
     """Re-check one claim of a kind other than ``counts`` (what :func:`verify_directory` does per claim).
 
     Returns (verified, message).  The certificate writers call it before
     writing, so that a file never holds a claim its own checker refuses.
+    ``verified``: the facts of claims verified before, for a kind that refers to them.
     """
-    if kind not in CHECKS:
-        raise ValueError(f"kind: expected one of {', '.join(CHECKS)}, got {kind!r}")
+    if kind not in CHECKS and kind not in SUPPORTED_CHECKS:
+        raise ValueError(f"kind: expected one of {', '.join(list(CHECKS) + list(SUPPORTED_CHECKS))}, got {kind!r}")
     try:
-        msg, _ = run_check(geometry, kind, claim, precision)
+        msg, _ = run_check(geometry, kind, claim, precision, verified)
     except Refused as exc:
         return False, str(exc)
     except MALFORMED as exc:

@@ -147,7 +147,7 @@ def verify_directory(path: str | Path, compare_summary: bool = True) -> list[Che
                 if kind == "counts":
                     msg, facts = check_count(claim, verified, summary)
                 else:
-                    msg, facts = run_check(geometry, kind, claim, doc.get("precision", 128))
+                    msg, facts = run_check(geometry, kind, claim, doc.get("precision", 128), verified)
             except Refused as exc:
                 results.append(CheckResult(name, cid, kind, False, str(exc)))
                 continue

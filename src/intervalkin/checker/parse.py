@@ -29,9 +29,10 @@ __all__ = ['FORMAT', 'VERSION', 'KINDS', 'INDEX', 'Refused', 'parse_exact',
 
 FORMAT = "intervalkin-certificate"
 VERSION = 1
-#: Claim files, in the order they are checked (``counts`` last: it uses the others).
+#: Claim files, in the order they are checked (``joint_join`` after the fold models it refers to, ``counts`` last:
+#: it uses the others).
 KINDS = ("dkp", "joint_cell", "aspect_distinct", "region_distinct", "box_labels", "trajectory", "aspect_connected",
-         "counts")
+         "joint_fold_model", "joint_join", "counts")
 INDEX = "index.json"
 #: Precisions (bits) accepted in a file.
 PREC_RANGE = (53, 4096)
