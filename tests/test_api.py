@@ -120,7 +120,9 @@ def test_count_status_and_json():
     assert Count(28, 12, None, False, "").status is Status.LOWER_BOUND
     assert Count(0, 0, None, False, "").status is Status.UNDECIDED
     assert Count(28, 12, None, False, "w").to_json() == {"count": 28, "exact": False, "lower_bound": 12,
-                                                          "upper_bound": None, "why": "w"}
+                                                          "upper_bound": None, "why": "w", "found": 28,
+                                                          "lower": 12, "upper": None, "undecided": {}}
+    assert Count(6, 6, 6, True, "", {"volume": 0.5}).to_json()["undecided"] == {"volume": 0.5}
 
 
 def test_analysis_counts(analysis):

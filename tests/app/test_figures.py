@@ -172,7 +172,7 @@ def test_an_adaptive_joint_paving_is_drawn_and_exported(tmp_path):
     for f in figs.values():
         pyplot().close(f)
     mesh = read_vtu(write_joint_vtu(tmp_path / "joint.vtu", joint))
-    assert set(np.unique(mesh.cell_data["cell"][0])) == {c.id for c in joint.cells}
+    assert set(np.unique(mesh.cell_data["cell"][0])) == {c.id for c in joint.cells + joint.fragments}
 
 
 def test_seam_crossings_are_found_and_placed_on_the_seam():

@@ -37,7 +37,8 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.constants import constants
 
-__all__ = ['leg_rho_sq', 'leg_moment', 'det_coefficients', 'quadratic', 'quadratic_gradient', 'quadratic_with_gradient',
+__all__ = ['leg_rho_sq', 'leg_moment', 'leg_vectors', 'det_from_legs',
+           'det_coefficients', 'quadratic', 'quadratic_gradient', 'quadratic_with_gradient',
            'approx_rho_sq', 'approx_inverse_kinematics', 'approx_det_a', 'approx_jacobian',
            'rho_sq_arb', 'inverse_kinematics_arb', 'det_a_arb', 'residual_arb', 'jacobian_arb']
 
@@ -108,7 +109,7 @@ def quadratic_with_gradient(coef, X, Y) -> tuple:
     return X * (aX + bY + d) + Y * (cY + e), (aX * 2.0 + bY + d, b * X + cY * 2.0 + e)
 
 
-def _legs(base, rotation, x, y, phi) -> list[tuple]:
+def leg_vectors(base, rotation, x, y, phi) -> list[tuple]:
     """[(d_ix, d_iy, r_ix, r_iy)] for the three legs; r_1 = (None, None)."""
     out = []
     for i in range(3):
@@ -118,7 +119,7 @@ def _legs(base, rotation, x, y, phi) -> list[tuple]:
     return out
 
 
-def _det(base, legs, x, y):
+def det_from_legs(base, legs, x, y):
     """det A = 8 Q from the legs' rotations (any number system)."""
     (_, _, r2x, r2y), (_, _, r3x, r3y) = legs[1], legs[2]
     e2x, e2y = base[1][0] - base[0][0], base[1][1] - base[0][1]
@@ -151,7 +152,7 @@ def _float_legs(geometry: Geometry, X):
         t = phi + k.alpha[i]
         return k.radius[i] * np.cos(t), k.radius[i] * np.sin(t)
 
-    return base, _legs(base, rotation, x, y, phi), x, y
+    return base, leg_vectors(base, rotation, x, y, phi), x, y
 
 
 def approx_rho_sq(geometry: Geometry, X: np.ndarray) -> np.ndarray:
@@ -168,7 +169,7 @@ def approx_inverse_kinematics(geometry: Geometry, X: np.ndarray) -> np.ndarray:
 def approx_det_a(geometry: Geometry, X: np.ndarray) -> np.ndarray:
     """det A in float64 for poses X of shape (..., 3); returns shape (...). Not certified."""
     base, legs, x, y = _float_legs(geometry, X)
-    return _det(base, legs, x, y)
+    return det_from_legs(base, legs, x, y)
 
 
 def approx_jacobian(geometry: Geometry, X: np.ndarray) -> np.ndarray:
@@ -192,7 +193,7 @@ def _arb_legs(geometry: Geometry, x, y, phi):
         px, py = platform[i]
         return px * c - py * s, px * s + py * c
 
-    return base, _legs(base, rotation, x, y, phi)
+    return base, leg_vectors(base, rotation, x, y, phi)
 
 
 def rho_sq_arb(geometry: Geometry, x, y, phi) -> list:
@@ -209,7 +210,7 @@ def inverse_kinematics_arb(geometry: Geometry, x, y, phi) -> list:
 def det_a_arb(geometry: Geometry, x, y, phi):
     """det A as an arb ball for arb arguments."""
     base, legs = _arb_legs(geometry, x, y, phi)
-    return _det(base, legs, x, y)
+    return det_from_legs(base, legs, x, y)
 
 
 def residual_arb(geometry: Geometry, x, y, phi, rho_sq) -> list:

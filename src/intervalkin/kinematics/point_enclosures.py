@@ -17,7 +17,7 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.constants import constants
-from intervalkin.kinematics.formulas import _det, _legs, leg_rho_sq
+from intervalkin.kinematics.formulas import det_from_legs, leg_rho_sq, leg_vectors
 
 __all__ = ["rho_sq_det_at"]
 
@@ -33,7 +33,7 @@ def rho_sq_det_at(geometry: Geometry, poses: np.ndarray) -> tuple[Interval, Inte
         t = phi + k.alpha_iv[i]
         return k.radius_iv[i] * t.cos(), k.radius_iv[i] * t.sin()
 
-    legs = _legs(base, rotation, x, y, phi)
+    legs = leg_vectors(base, rotation, x, y, phi)
     sq = [leg_rho_sq(*leg) for leg in legs]
-    det = _det(base, legs, x, y)
+    det = det_from_legs(base, legs, x, y)
     return Interval(np.stack([s.lo for s in sq], 1), np.stack([s.hi for s in sq], 1)), det

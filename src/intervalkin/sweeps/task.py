@@ -31,11 +31,12 @@ _SAMPLE = 0.05
 
 def count_from_json(doc: dict) -> Count:
     """A :class:`Count` back from its cached form (its invariants are re-checked)."""
-    return Count(doc["found"], doc["lower"], doc["upper"], doc["exact"], doc.get("why", ""))
+    return Count(doc["found"], doc["lower"], doc["upper"], doc["exact"], doc.get("why", ""), doc.get("undecided") or {})
 
 
 def _count_json(c: Count) -> dict:
-    return {"found": c.found, "lower": c.lower, "upper": c.upper, "exact": c.exact, "why": c.why}
+    return {"found": c.found, "lower": c.lower, "upper": c.upper, "exact": c.exact, "why": c.why,
+            "undecided": dict(c.undecided)}
 
 
 def joint_cells_count(analysis) -> Count:
