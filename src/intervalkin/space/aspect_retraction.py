@@ -52,8 +52,8 @@ from intervalkin.kinematics.enclosures import (
     rho_sq_interval,
 )
 
-__all__ = ["PHI_DIVISOR", "GRID", "FINE_GRID", "WEIGHT_GRID", "DIRECTIONS", "BoxRetraction", "exit_faces", "classify_boxes", "shared_direction",
-           "approx_free_of_aspect"]
+__all__ = ["PHI_DIVISOR", "GRID", "FINE_GRID", "WEIGHT_GRID", "DIRECTIONS", "BoxRetraction", "exit_faces",
+           "classify_boxes", "shared_direction", "constraint_values", "approx_free_of_aspect"]
 
 #: e = (a, b, c / PHI_DIVISOR): a turn of the platform moves its points about 20 times further than
 #: a unit shift, so the phi component is scaled down to balance the gradients.

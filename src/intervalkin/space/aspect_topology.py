@@ -321,9 +321,10 @@ def separations(level: np.ndarray, ijk: np.ndarray, depth: int, out: np.ndarray,
     ``piece``: component of the union of the closed non-OUT boxes (boxes that meet at a face, an
     edge or a corner, :func:`~intervalkin.paving.adjacency.touching_pairs`; phi wraps), -1 on OUT
     boxes; ``group``: face-connected group of sinks (``edges``: face adjacency), -1 elsewhere;
-    ``separated``: number of pieces holding a sink; ``touching``: the pairs of non-OUT boxes that meet.  The pieces are closed, pairwise disjoint and
-    cover S (the OUT boxes hold none of it): a piece holding a sink holds its own components of S,
-    so S has at least ``separated`` components (proofs/lemma-aspect-retraction.md, "Separations").
+    ``separated``: number of pieces holding a sink; ``touching``: the pairs of non-OUT boxes that meet.
+    The pieces are closed, pairwise disjoint and cover S (the OUT boxes hold none of it): a piece
+    holding a sink holds its own components of S, so S has at least ``separated`` components
+    (proofs/lemma-aspect-retraction.md, "Separations").
     """
     touching = touching_pairs(level, ijk, depth, ~out)
     piece = component_labels(len(level), touching, ~out)
