@@ -61,7 +61,7 @@ from intervalkin.space.aspect_retraction import (
     approx_free_of_aspect,
     classify_boxes,
     exit_faces,
-    shared_direction,
+    shared_directions,
 )
 
 __all__ = ["OUT", "SINK", "RET", "LEFT", "AspectCover", "AspectTopology", "face_pairs", "resolve_cover",
@@ -76,6 +76,8 @@ MAX_BOXES = 200_000
 #: Passes of shared directions per round: a cluster's direction is averaged over all its boxes; once part of
 #: it is resolved, the rest (often one corner of S) gets a direction of its own.
 SHARE_PASSES = 4
+#: Share again only when the last pass resolved at least this fraction of the boxes left.
+SHARE_GAIN = 0.125
 #: Most groups of sinks a cover may use when one group cannot be reached from everywhere.
 MAX_GROUPS = 8
 
@@ -363,13 +365,14 @@ def _classified(geometry, domain, level, ijk, sign):
 def _share_directions(geometry, domain, level, ijk, kind, edges, sign, ok, custom) -> None:
     """Give each face-connected cluster of LEFT boxes one shared direction where it is certified (in place)."""
     left = kind == LEFT
-    comp = component_labels(len(level), edges, left)
-    for c in range(int(comp.max()) + 1 if np.any(left) else 0):
-        rows = np.flatnonzero(comp == c)
-        lo, hi = box_bounds(domain, level[rows], ijk[rows])
-        e, good = shared_direction(geometry, np.stack([lo, hi], axis=-1), sign)
-        custom[rows[good], 2] = e
-        ok[rows[good], -1] = True
+    if not np.any(left):
+        return
+    rows = np.flatnonzero(left)
+    comp = component_labels(len(level), edges, left)[rows]
+    lo, hi = box_bounds(domain, level[rows], ijk[rows])
+    e, good = shared_directions(geometry, np.stack([lo, hi], axis=-1), sign, comp)
+    custom[rows[good], 2] = e[comp[good]]
+    ok[rows[good], -1] = True
 
 
 def _resolve_shared(geometry, domain, level, ijk, depth, sign, out, inside, ok, custom, vol, max_groups):
@@ -382,7 +385,7 @@ def _resolve_shared(geometry, domain, level, ijk, depth, sign, out, inside, ok, 
             break
         _share_directions(geometry, domain, level, ijk, res[0], res[4], sign, ok, custom)
         res = resolve_cover(level, ijk, depth, out, inside, ok, exit_faces(custom), vol, max_groups, adjacency)
-        if np.count_nonzero(res[0] == LEFT) >= left:
+        if np.count_nonzero(res[0] == LEFT) > (1 - SHARE_GAIN) * left:  # again only while a pass pays
             break
     return res
 
@@ -413,7 +416,7 @@ def cover_aspect(geometry: Geometry, sign: int, start_depth: int = 9, max_depth:
         args = (geometry, domain, level, ijk, depth, sign, out, inside, ok, custom, vol)
         kind, rank, choice, fragments, edges, groups = one = _resolve_shared(*args, 1)
         crowded = np.zeros(len(level), dtype=bool)
-        if np.any(kind == LEFT):
+        if np.any(kind == LEFT) and np.any(inside & (kind == LEFT)):
             # more groups of sinks where one group does not reach everything; a group cut off from the others by
             # OUT boxes is another component (no refinement can join it); where two groups share a piece of the
             # non-OUT boxes, the boxes one group could not reach are refined, in the hope of a join
