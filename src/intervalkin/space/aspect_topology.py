@@ -34,7 +34,7 @@ How the cover is built: boxes are split top-down while neither OUT, IN nor
 retractable (up to ``start_depth``); then ranks are computed by a fixed point over
 the face adjacency (a worklist: each rank looks only at the boxes beside those
 resolved at the rank before); clusters of unresolved boxes get one shared direction
-(corners of S_s), again while that resolves more.  What one group of sinks cannot
+(corners of S_s), again while a pass resolves an eighth of what is left.  What one group of sinks cannot
 reach is resolved with more groups (the largest unreached fragment of IN boxes first,
 up to MAX_GROUPS); where two groups share a piece, the boxes the first group could not
 reach are refined while that joins groups, then the boxes where the groups' regions
