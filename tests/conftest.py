@@ -67,3 +67,22 @@ def fold_paving(paper_geometry):
     from intervalkin.space.joint_paving import pave_joint_space
 
     return pave_joint_space(paper_geometry, 5, 1, fold=True)
+
+
+SECOND_DESIGN = Path(__file__).parents[1] / "examples" / "second_design_0246.toml"
+
+
+@pytest.fixture(scope="session")
+def second_geometry():
+    """examples/second_design_0246.toml: a second manipulator with 0, 2, 4 and 6 solutions (issue 14)."""
+    from intervalkin.core.geometry import load_geometry
+
+    return load_geometry(SECOND_DESIGN)
+
+
+@pytest.fixture(scope="session")
+def second_aspect_topology(second_geometry):
+    """The covers of the second design's two signs (about 3 s): two components of each sign, 4 aspects."""
+    from intervalkin.space.aspect_topology import prove_aspects
+
+    return prove_aspects(second_geometry)

@@ -1,9 +1,11 @@
 """The independent checker on ``aspect_connected`` claims: the real claims verify, falsified ones are refused.
 
 Each tampering is one a faulty library could produce: a retraction along the wrong direction,
-a box called a sink (a false join of fragments), a retracting box listed before the boxes it
-retracts onto (a cycle), a box left out (a hole where a piece of an aspect could hide), a
-domain too small, and counts declared exact without the covers.  The arb proofs run box by
+a box called a sink (a false join of fragments, or of two groups of sinks of the second design
+that are different components), a retracting box listed before the boxes it retracts onto (a
+cycle), a box left out (a hole where a piece of an aspect could hide), a wall of boxes called
+OUT (a false separation), a combination with the wrong weights, a domain too small, and counts
+declared exact without the covers.  The arb proofs run box by
 box after the cheap combinatorial steps, so the tamperings are placed where they fail fast.
 """
 
@@ -17,19 +19,29 @@ from flint import arb, ctx
 
 from intervalkin.certify.aspect_claims import aspect_connected_claims
 from intervalkin.checker import check_claim
-from intervalkin.checker.aspects import _box, retracts
+import networkx as nx
+
+from intervalkin.checker.aspects import _box, _separate_pieces, _sink_groups, retracts
 from intervalkin.checker.labels import holds_on_box
-from intervalkin.checker.claims import check_count, count_upper
+from intervalkin.checker.claims import check_count, count_bound, count_upper
 from intervalkin.checker.model import ArbModel, balls
 from intervalkin.checker.parse import Refused
 from intervalkin.checker.taylor import HyperDual, slope_enclosure, value_enclosure
-from intervalkin.space.aspect_retraction import classify_boxes
+from intervalkin.space.aspect_retraction import classify_boxes, constraint_values
+from intervalkin.paving.adjacency import component_labels
 from intervalkin.space.aspect_topology import SINK, face_pairs
 
 
 @pytest.fixture(scope="module")
 def claims(aspect_topology):
     got, omitted = aspect_connected_claims(aspect_topology)
+    assert not omitted and [c["id"] for c in got] == ["WA1", "WA2"]
+    return got
+
+
+@pytest.fixture(scope="module")
+def second_claims(second_aspect_topology):
+    got, omitted = aspect_connected_claims(second_aspect_topology)
     assert not omitted and [c["id"] for c in got] == ["WA1", "WA2"]
     return got
 
@@ -156,3 +168,87 @@ def test_taylor_forms_enclose_and_tighten(paper_geometry):
             assert v.overlaps(model.det(*p))
             at = model.det(*[HyperDual(q, d, arb(0), arb(0)) for q, d in zip(p, e)])
             assert s.overlaps(at.a)
+
+
+def test_the_second_design_has_exactly_four_aspects(second_geometry, second_claims):
+    """Each sign: two groups of sinks, each in its own piece of the non-OUT boxes (re-proved in arb, the pieces
+    recomputed from the rows): exactly two components; with the opposite signs, the count is 4 from below
+    and from above."""
+    facts = [{"signs": {1, -1}}]
+    for claim in second_claims:
+        ok, why = check_claim(second_geometry, "aspect_connected", claim)
+        assert ok, why
+        assert "exactly 2 components" in why
+        keys = {tuple(r[:4]) for r in claim["boxes"]}
+        rows = [(tuple(r[:4]), r[4]) for r in claim["boxes"]]
+        assert _separate_pieces(keys, rows) == 2
+        facts.append({"aspect_sign": 1 if claim["aspect"] == "WA1" else -1, "components_at_most": 2,
+                      "components_at_least": 2})
+    assert count_bound("aspects", facts) == count_upper("aspects", facts) == 4
+    assert count_bound("aspects", facts[:1]) == 2  # the signs alone prove 2
+
+
+def _join_path(cover, claim):
+    """Rows (level, i, j, k) of a shortest face path of boxes from one group of sinks to the other."""
+    depth = int(cover.level.max())
+    edges = face_pairs(cover.level, cover.ijk, depth)[2]
+    group = component_labels(len(cover.level), edges, cover.kind == SINK)
+    g = nx.Graph()
+    g.add_edges_from(edges.T.tolist())
+    g.add_edges_from(("A", int(v)) for v in np.flatnonzero(group == 0))
+    g.add_edges_from(("B", int(v)) for v in np.flatnonzero(group == 1))
+    path = [v for v in nx.shortest_path(g, "A", "B")[2:-2]]
+    return [[int(cover.level[v])] + cover.ijk[v].tolist() for v in path]
+
+
+def test_a_false_join_of_two_groups_of_sinks_is_refused(second_geometry, second_claims, second_aspect_topology):
+    """The boxes of a shortest face path between the two groups of sinks of WA1 called sinks: the rows alone
+    now show one group (a join of two different components), and the arb step refuses a box of the path."""
+    claim = copy.deepcopy(second_claims[0])
+    path = _join_path(second_aspect_topology.covers[0], claim)
+    assert len(path) > 3
+    on_path = {tuple(p) for p in path}
+    rows = [r for r in claim["boxes"] if tuple(r[:4]) not in on_path]
+    claim["boxes"] = [p + [-2] for p in path] + rows
+    keys = {tuple(r[:4]) for r in claim["boxes"]}
+    sinks = [tuple(r[:4]) for r in claim["boxes"] if r[4] == -2]
+    deepest = max(r[0] for r in claim["boxes"])
+    assert _sink_groups(keys, sinks, deepest) == 1  # combinatorially joined
+    assert "not proved inside WA1" in _refused(second_geometry, claim)
+
+
+def test_a_false_separation_is_refused(paper_geometry, claims):
+    """Every box meeting phi = 0 or phi = pi called OUT: two walls cut the paper's WA1 into two pieces that
+    both hold sinks (a false proof of a second component); the arb step refuses a box of the walls."""
+    claim = copy.deepcopy(claims[0])
+    domain = [[float.fromhex(lo), float.fromhex(hi)] for lo, hi in claim["domain"]]
+
+    def on_wall(r):
+        lo, hi = _box(domain, tuple(r[:4]))[2]
+        return any(lo <= w <= hi for w in (0.0, float(np.pi)))
+
+    wall = [r for r in claim["boxes"] if on_wall(r) and r[4] != -1]
+    rest = [r for r in claim["boxes"] if not (on_wall(r) and r[4] != -1)]
+    claim["boxes"] = [r[:4] + [-1] for r in wall] + rest
+    keys = {tuple(r[:4]) for r in claim["boxes"]}
+    assert _separate_pieces(keys, [(tuple(r[:4]), r[4]) for r in claim["boxes"]]) == 2
+    assert "not proved free of WA1" in _refused(paper_geometry, claim)
+
+
+def test_a_combination_with_wrong_weights_is_refused(paper_geometry, claims):
+    """OUT rows proved by a combination given, instead, the weight of one constraint that is satisfied on the
+    whole box (so the sum is positive there): refused, whichever constraint it is."""
+    claim0 = claims[0]
+    assert claim0["combinations"]
+    domain = [[float.fromhex(lo), float.fromhex(hi)] for lo, hi in claim0["domain"]]
+    rows = [r for r in claim0["boxes"] if r[4] <= -3][:3]
+    boxes = np.array([_box(domain, tuple(r[:4])) for r in rows])
+    values = constraint_values(paper_geometry, boxes, 1)
+    for row, low in zip(rows, values.lo):
+        j = int(np.argmax(low))
+        assert low[j] > 0
+        claim = copy.deepcopy(claim0)
+        claim["combinations"].append([int(k == j) for k in range(7)])
+        mutated = row[:4] + [-3 - (len(claim["combinations"]) - 1)]
+        claim["boxes"] = [mutated] + [r for r in claim["boxes"] if r[:4] != row[:4]]
+        assert "by the combination" in _refused(paper_geometry, claim)

@@ -16,7 +16,7 @@ from flint import arb, ctx
 
 from intervalkin.checker.model import ArbModel
 from intervalkin.space.aspect_retraction import DIRECTIONS, PHI_DIVISOR, classify_boxes, exit_faces
-from intervalkin.space.aspect_topology import RET
+from intervalkin.space.aspect_topology import OUT, RET
 
 
 def _constraints(model: ArbModel, x: float, y: float, phi: float, sign: int) -> list:
@@ -81,3 +81,46 @@ def test_a_reversed_direction_is_not_certified(aspect_topology, paper_geometry):
         assert c.ok[k, index[tuple(e)]]
         reversed_refused += not c.ok[k, index[tuple(-v for v in e)]]
     assert reversed_refused > 50
+
+
+def test_points_of_boxes_out_by_a_combination_are_not_in_the_aspect(aspect_topology, paper_geometry):
+    """OUT boxes proved by a combination sum_j w_j f_j < 0 (the module docstring): at sampled points, in arb
+    at 200 bits, the combination is negative and some constraint with a positive weight is violated.
+    Would catch a wrong gradient in the centred form or weights put on the wrong constraints."""
+    model = ArbModel(paper_geometry)
+    rng = np.random.default_rng(20261125)
+    seen = 0
+    with ctx.workprec(200):
+        for cover in aspect_topology.covers:
+            rows = np.flatnonzero(np.any(cover.weights > 0, axis=1))
+            assert rows.size > 0 and np.all(cover.kind[rows] == OUT)
+            for box, w in zip(cover.boxes(np.isin(np.arange(len(cover.kind)), rows)), cover.weights[rows]):
+                assert np.all(w >= 0) and np.count_nonzero(w) >= 2
+                for _ in range(4):
+                    p = box[:, 0] + rng.random(3) * (box[:, 1] - box[:, 0])
+                    vals = _constraints(model, *p, cover.sign)
+                    assert sum(int(wj) * v for wj, v in zip(w, vals)) < 0, (box.tolist(), w.tolist())
+                    assert any(wj > 0 and v < 0 for wj, v in zip(w, vals))
+                    seen += 1
+    assert seen > 100
+
+
+def test_a_thin_corner_gets_a_fine_direction(monkeypatch):
+    """Where rho_1 = rho_min, rho_2 = rho_min and det A = 0 meet with nearly dependent gradients (smallest
+    singular value about 0.025 after normalising), the valid directions form a cone a few hundredths of a
+    radian wide: none of the fixed directions lies in it, and the per-box direction rounded to the coarse
+    grid (components up to GRID) falls outside it; rounded to FINE_GRID it stays inside."""
+    from pathlib import Path
+
+    from intervalkin.core.geometry import load_geometry
+    from intervalkin.space import aspect_retraction
+
+    g = load_geometry(Path(__file__).parents[1] / "data" / "concurrent_legs.toml")
+    box = np.array([[[16.1167, 16.1192], [13.1628, 13.1652], [0.19255, 0.19275]]])
+    c = classify_boxes(g, box, -1)
+    assert not c.out[0] and not c.inside[0]
+    assert not np.any(c.ok[0, :len(DIRECTIONS)])
+    assert np.any(c.ok[0, len(DIRECTIONS):])
+    monkeypatch.setattr(aspect_retraction, "FINE_GRID", aspect_retraction.GRID)
+    coarse = classify_boxes(g, box, -1)
+    assert not np.any(coarse.ok[0])

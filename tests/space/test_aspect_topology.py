@@ -1,13 +1,31 @@
-"""Covers of the aspects: tiling, ranks, and the exact count of 2 on the paper's manipulator."""
+"""Covers of the aspects: tiling, ranks, separations, and exact counts (2 on the paper's manipulator)."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from pathlib import Path
+
+import pytest
+
+from intervalkin.core.geometry import load_geometry
 from intervalkin.core.status import Count, Status
-from intervalkin.paving.adjacency import component_labels, shares_face
+from intervalkin.paving.adjacency import component_labels, shares_face, touching_pairs, touching_pairs_bruteforce
+from intervalkin.paving.tree import split_boxes
 from intervalkin.space.aspect_retraction import DIRECTIONS, exit_faces
-from intervalkin.space.aspect_topology import LEFT, OUT, RET, SINK, AspectTopology, face_pairs, resolve_cover
+from intervalkin.space.aspect_topology import (
+    LEFT,
+    OUT,
+    RET,
+    SINK,
+    AspectTopology,
+    face_pairs,
+    prove_aspects,
+    resolve_cover,
+    separations,
+)
+
+DATA = Path(__file__).parents[1] / "data"
 
 
 def test_the_paper_has_exactly_two_aspects(aspect_topology):
@@ -15,6 +33,7 @@ def test_the_paper_has_exactly_two_aspects(aspect_topology):
     assert aspect_topology.upper == 2
     for cover in aspect_topology.covers:
         assert cover.connected and not cover.empty and not cover.leftovers()
+        assert cover.exact and cover.components_at_least == cover.components_at_most == 1
         assert cover.fragments > 1  # the IN boxes alone are fragmented: the retractions join them
     found = Count(2, 2, None, False, "signs")
     c = aspect_topology.count(found)
@@ -108,3 +127,63 @@ def test_a_fragment_no_chain_reaches_becomes_another_group_of_sinks():
     kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, 2, out, inside, ok, faces, vol, 2)
     assert groups == 2 and kind[first] == kind[second] == SINK
     assert np.all(kind[~inside] == LEFT)
+
+
+def _random_tiling(rng, rounds: int = 4):
+    level, ijk = np.zeros(1, dtype=np.int64), np.zeros((1, 3), dtype=np.int64)
+    for r in range(rounds):
+        cut = (rng.random(len(level)) < 0.5) | (r == 0)
+        cl, cijk = split_boxes(level[cut], ijk[cut])
+        level, ijk = np.concatenate([level[~cut], cl]), np.concatenate([ijk[~cut], cijk])
+    return level, ijk
+
+
+def test_touching_pairs_agree_with_brute_force():
+    """Closed boxes meeting at a face, an edge or a corner (phi wraps), with and without a mask, on random
+    octree tilings: the Z-order lookup finds exactly the pairs of the O(n^2) reference."""
+    rng = np.random.default_rng(14)
+    for _ in range(5):
+        level, ijk = _random_tiling(rng)
+        depth = int(level.max())
+        ref = set(map(tuple, touching_pairs_bruteforce(level, ijk, depth).T.tolist()))
+        assert set(map(tuple, touching_pairs(level, ijk, depth).T.tolist())) == ref
+        mask = rng.random(len(level)) < 0.6
+        got = set(map(tuple, touching_pairs(level, ijk, depth, mask).T.tolist()))
+        assert got == {p for p in ref if mask[p[0]] and mask[p[1]]}
+        faces = set(map(tuple, shares_face(level, ijk, depth).T.tolist()))
+        assert faces <= ref
+
+
+def test_separations_count_pieces_not_face_groups():
+    """Two sink cells meeting only along an edge are two face groups but one piece (their closed union is
+    connected); a layer of OUT cells between them makes two pieces; across the phi seam they meet again."""
+    level = np.full(64, 2, dtype=np.int64)
+    ijk = np.array([[i, j, k] for i in range(4) for j in range(4) for k in range(4)], dtype=np.int64)
+    at = {tuple(c): n for n, c in enumerate(ijk.tolist())}
+    edges = shares_face(level, ijk, 2)
+
+    def run(out_cells, sink_cells):
+        out = np.zeros(64, dtype=bool)
+        out[[at[c] for c in out_cells]] = True
+        sink = np.zeros(64, dtype=bool)
+        sink[[at[c] for c in sink_cells]] = True
+        piece, group, separated, _ = separations(level, ijk, 2, out, sink, edges)
+        return int(group.max()) + 1, separated
+
+    everything_else = [c for c in at if c not in ((1, 1, 1), (2, 2, 1))]
+    assert run(everything_else, [(1, 1, 1), (2, 2, 1)]) == (2, 1)  # an edge: one piece
+    far = [c for c in at if c not in ((0, 0, 1), (3, 3, 1))]
+    assert run(far, [(0, 0, 1), (3, 3, 1)]) == (2, 2)  # OUT cells between: two pieces
+    seam = [c for c in at if c not in ((1, 1, 0), (2, 2, 3))]
+    assert run(seam, [(1, 1, 0), (2, 2, 3)]) == (2, 1)  # phi = hi is phi = lo: an edge across the seam
+
+
+@pytest.mark.parametrize("name, groups", [("offset_right.toml", (1, 2)), ("concurrent_legs.toml", (1, 1))])
+def test_the_test_geometries_close_with_exact_counts(name, groups):
+    """offset_right: WA2 has two components, cut apart by OUT boxes (3 aspects); concurrent_legs: its
+    thin corners (nearly dependent gradients) close with fine directions and combinations (2 aspects)."""
+    topo = prove_aspects(load_geometry(DATA / name))
+    for cover, k in zip(topo.covers, groups):
+        assert cover.closed and cover.exact and cover.groups == cover.separated == k
+    c = topo.count(Count(2, 2, None, False, "signs"))
+    assert (c.found, c.lower, c.upper, c.exact) == (sum(groups),) * 3 + (True,)

@@ -7,7 +7,9 @@
 - the direct joint paving at depth 4 already finds cells of 0, 2, 4 and 6 solutions;
 - seeded random joint vectors that the paving places in a cell get the cell's
   count and split from an independent certified solve;
-- the whole chain (pipeline.analyse) runs on it and its counts keep their bounds.
+- the whole chain (pipeline.analyse) runs on it and its counts keep their bounds;
+- its aspects are exactly 4: each sign's part of W has two components, joined inside
+  by retractions and cut apart by OUT boxes (tests/checker/test_aspects.py re-proves it).
 """
 
 from __future__ import annotations
@@ -20,8 +22,11 @@ import numpy as np
 import pytest
 
 from intervalkin.core.geometry import load_geometry
+from intervalkin.core.status import Count
+from intervalkin.paving.adjacency import component_labels
 from intervalkin.pipeline import analyse
 from intervalkin.solve.dkp import solve
+from intervalkin.space.aspect_topology import SINK, face_pairs
 from intervalkin.space.joint_paving import pave_joint_space
 
 EXAMPLE = Path(__file__).parents[2] / "examples" / "second_design_0246.toml"
@@ -114,3 +119,25 @@ def test_the_chain_runs_and_keeps_its_bounds(geometry):
     assert counts.uniqueness_domains.lower >= 6
     assert counts.basic_regions.lower >= 6
     assert {c.count for c in a.cells.cells} >= {0, 2, 4, 6}
+
+
+def test_the_aspects_are_exactly_four(second_aspect_topology):
+    """Each sign: a closed cover, two groups of sinks, each in its own piece of the non-OUT boxes, so
+    exactly two components; the count (found 2 by opposite signs) is raised and proved: 4 aspects.
+    The two groups of a sign are far apart (no thin neck, nothing at the phi seam): their sink boxes
+    are more than 5 apart in (x, y, 20 phi), phi taken modulo 2 pi."""
+    for cover in second_aspect_topology.covers:
+        assert cover.closed and cover.exact
+        assert cover.groups == cover.separated == 2
+        assert cover.seconds < 10
+        depth = int(cover.level.max())
+        group = component_labels(len(cover.level), face_pairs(cover.level, cover.ijk, depth)[2], cover.kind == SINK)
+        boxes = cover.boxes()
+        a, b = boxes[group == 0][:, None], boxes[group == 1][None]
+        gap = [np.maximum(0, np.maximum(a[..., k, 0] - b[..., k, 1], b[..., k, 0] - a[..., k, 1])) for k in range(3)]
+        span = np.maximum(a[..., 2, 1], b[..., 2, 1]) - np.minimum(a[..., 2, 0], b[..., 2, 0])
+        gap[2] = np.minimum(gap[2], np.maximum(0, 2 * np.pi - span))  # around the seam
+        assert np.sqrt(gap[0] ** 2 + gap[1] ** 2 + (20 * gap[2]) ** 2).min() > 5
+    c = second_aspect_topology.count(Count(2, 2, None, False, "opposite signs"))
+    assert (c.found, c.lower, c.upper, c.exact) == (4, 4, 4, True)
+    assert "cutting" in c.why

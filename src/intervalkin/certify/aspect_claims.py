@@ -2,7 +2,9 @@
 
 Each claim holds the cover as rows ``[level, i, j, k, code]`` (integer octree
 coordinates of the paving domain, written as hex floats): code -1 OUT, -2 SINK,
-d >= 0 a retraction along ``directions[d]`` = (a, b, c), e = (a, b, c / phi_divisor).
+d >= 0 a retraction along ``directions[d]`` = (a, b, c), e = (a, b, c / phi_divisor),
+-3 - c OUT by the combination ``combinations[c]`` = (w_1, ..., w_7) of the seven
+constraints (sum_j w_j f_j < 0 on the box).
 OUT and SINK rows come first, then the retracting boxes by increasing rank, so
 that every box across an exit face of a retracting box is listed before it.  The
 checker (:mod:`intervalkin.checker.aspects`) re-proves every row in arb and the
@@ -30,6 +32,10 @@ def aspect_cover_claim(cover: AspectCover) -> dict:
         raise ValueError("a cover with unresolved boxes proves nothing: it has no claim")
     code = np.full(len(cover.level), -1, dtype=np.int64)
     code[cover.kind == SINK] = -2
+    weights = np.zeros((len(cover.level), 7), dtype=np.int64) if cover.weights is None else cover.weights
+    mixed = np.flatnonzero((cover.kind == OUT) & np.any(weights > 0, axis=1))
+    combos, cinv = np.unique(weights[mixed], axis=0, return_inverse=True)
+    code[mixed] = -3 - cinv.reshape(-1)
     ret = np.flatnonzero(cover.kind == RET)
     dirs, inv = np.unique(cover.direction[ret], axis=0, return_inverse=True)
     code[ret] = inv.reshape(-1)
@@ -43,11 +49,14 @@ def aspect_cover_claim(cover: AspectCover) -> dict:
         "domain": [[float(lo).hex(), float(hi).hex()] for lo, hi in cover.domain],
         "phi_divisor": PHI_DIVISOR,
         "directions": dirs.tolist(),
+        "combinations": combos.reshape(-1, 7).tolist(),
         "boxes": rows,
         "statement": (f"{name} (the poses of W with det A {'>' if cover.sign > 0 else '<'} 0) is nonempty with "
-                      f"at most {cover.groups} component(s): these {len(rows)} boxes tile the paving domain; the "
-                      f"sinks lie inside {name} in {cover.groups} face-connected group(s); every other box is free "
-                      f"of {name} or retracts along its direction onto boxes listed before it"),
+                      f"at least {cover.components_at_least} and at most {cover.groups} component(s): these "
+                      f"{len(rows)} boxes tile the paving domain; the sinks lie inside {name} in {cover.groups} "
+                      f"face-connected group(s); every other box is free of {name} or retracts along its direction "
+                      f"onto boxes listed before it; the boxes not free of {name} make "
+                      f"{cover.components_at_least} separate piece(s) holding sinks"),
     }
 
 

@@ -3,15 +3,18 @@
 For s = +1 (WA1) or -1 (WA2) let S = {X in W : s det A(X) > 0}.  The claim lists
 boxes by integer octree coordinates (level L, i, j, k) of a domain D (hex floats),
 each with a code: ``-1`` OUT (no point of S in the box), ``-2`` SINK (the box lies
-in S), or d >= 0: RET along the direction ``directions[d]`` = (a, b, c), i.e.
-e = (a, b, c / phi_divisor).  The checker re-proves, from the geometry alone:
+in S), d >= 0: RET along the direction ``directions[d]`` = (a, b, c), i.e.
+e = (a, b, c / phi_divisor), or -3 - c: OUT by the combination ``combinations[c]``
+= (w_1, ..., w_7), integers >= 0 (optional field; none when absent).  The checker
+re-proves, from the geometry alone:
 
 1. D holds W: [x] and [y] contain A1 -+ rho_max_1 (exact rationals), and the phi
    range is 2 pi plus at most one finest slice, so that phi = phi_hi is phi_lo + 2 pi
    up to a point of the first slice (arb);
 2. the boxes tile D: no duplicate, no box inside another, volumes summing to D's;
 3. each box's code, in arb, on sub-boxes covering it (bisected while undecided):
-   OUT: some leg certified beyond a limit, or s det A certified < 0; SINK: every leg
+   OUT: some leg certified beyond a limit, or s det A certified < 0; OUT by a
+   combination: sum_j w_j f_j certified < 0 (then at each point some f_j < 0); SINK: every leg
    certified within its limits and s det A > 0; RET: each of the seven constraints
    (rho_i^2 - rho_min_i^2 >= 0, rho_max_i^2 - rho_i^2 >= 0, s det A > 0) certified
    satisfied or certified nondecreasing along e (values and D_e enclosed by the
@@ -19,11 +22,17 @@ e = (a, b, c / phi_divisor).  The checker re-proves, from the geometry alone:
 4. there is at least one SINK box; their face-connected groups (phi wraps) are counted;
 5. in list order, every box across an exit face of a RET box (a face whose outward
    normal has a positive component along e) is OUT, a SINK or an earlier RET box,
-   and no exit face lies on the x or y border of D.
+   and no exit face lies on the x or y border of D;
+6. the pieces: components of the union of the closed boxes that are not OUT (boxes
+   meeting at a face, an edge or a corner; phi wraps), counted when they hold a sink.
+   For this the phi range must exceed 2 pi by strictly less than its first and last
+   finest slices, and the float cuts of the finest slices must increase strictly
+   (boxes apart in integer coordinates are apart as real boxes).
 
 Then S is nonempty with at most as many components as there are face-connected
-groups of sinks, and connected when there is one group
-(proofs/lemma-aspect-retraction.md); a cover made of OUT boxes only proves S empty.  Standard library and python-flint only.
+groups of sinks, and connected when there is one group; it has at least as many
+components as there are pieces holding a sink (proofs/lemma-aspect-retraction.md); a
+cover made of OUT boxes only proves S empty.  Standard library and python-flint only.
 """
 
 from __future__ import annotations
@@ -40,11 +49,18 @@ from intervalkin.checker.model import ArbModel, balls
 from intervalkin.checker.parse import Refused, get, read_aspect, read_hex_box, read_int
 from intervalkin.checker.taylor import centred_enclosure, slope_enclosure, value_enclosure
 
-__all__ = ["MAX_LEVEL", "retracts", "check_aspect_connected"]
+__all__ = ["MAX_LEVEL", "retracts", "combination_negative", "check_aspect_connected"]
 
 #: Deepest octree level a cover may use.
 MAX_LEVEL = 20
+#: Largest weight of a combination.
+MAX_WEIGHT = 1 << 40
 _OUT, _SINK = -1, -2
+
+
+def _is_out(code: int) -> bool:
+    """OUT (-1) or OUT by a combination (-3 - c)."""
+    return code == _OUT or code <= -3
 
 
 def _leg(model: ArbModel, i: int) -> Callable:
@@ -134,6 +150,29 @@ def retracts(model: ArbModel, b, sign: int, e) -> bool:
     return _has_sign(model.det, box, sign, d)
 
 
+def combination_negative(model: ArbModel, b, sign: int, w) -> bool:
+    """PROVED on the box ``b``: sum_j w_j f_j < 0 for the seven constraints (w: 7 integers >= 0, not all 0).
+
+    f_i = rho_i^2 - rho_min_i^2, f_{3+i} = rho_max_i^2 - rho_i^2 (i = 1, 2, 3), f_7 = sign det A.
+    At each point of the box some f_j with w_j > 0 is then negative: the point is not in S.
+    Natural form, then the first- and second-order Taylor forms.
+    """
+    legs = [_leg(model, i) for i in range(3)]
+    wa = [arb(v) for v in w]
+    rest = sum(wa[3 + i] * model.rmax2[i] - wa[i] * model.rmin2[i] for i in range(3))
+
+    def f(x, y, phi):
+        total = rest
+        for i in range(3):
+            if w[i] or w[3 + i]:
+                total = total + (wa[i] - wa[3 + i]) * legs[i](x, y, phi)
+        if w[6]:
+            total = total + wa[6] * sign * model.det(x, y, phi)
+        return total
+
+    return _has_sign(f, balls(b), -1)
+
+
 def _cut(lo: float, hi: float, level: int, i: int) -> float:
     """The float bound of slice i at ``level``: the paving's formula (shared faces are bitwise equal)."""
     if i == 1 << level:
@@ -172,6 +211,17 @@ def _read_rows(claim: dict):
         if (a, b, c) == (0, 0, 0):
             raise Refused(f"directions[{n}]: the zero vector retracts nothing")
         e.append((a, b, c, div))
+    combos = claim.get("combinations", [])
+    if not isinstance(combos, list):
+        raise Refused("combinations: expected a list of [w_1, ..., w_7]")
+    w = []
+    for n, c in enumerate(combos):
+        if not isinstance(c, list) or len(c) != 7:
+            raise Refused(f"combinations[{n}]: expected 7 weights")
+        ws = tuple(read_int(v, f"combinations[{n}]", 0, MAX_WEIGHT) for v in c)
+        if not any(ws):
+            raise Refused(f"combinations[{n}]: all weights are 0")
+        w.append(ws)
     rows = get(claim, "boxes")
     if not isinstance(rows, list) or not rows:
         raise Refused("boxes: expected a non-empty list of [level, i, j, k, code]")
@@ -181,8 +231,8 @@ def _read_rows(claim: dict):
             raise Refused(f"boxes[{n}]: expected [level, i, j, k, code]")
         lev = read_int(row[0], f"boxes[{n}] level", 0, MAX_LEVEL)
         key = (lev,) + tuple(read_int(v, f"boxes[{n}] index", 0, (1 << lev) - 1) for v in row[1:4])
-        out.append((key, read_int(row[4], f"boxes[{n}] code", -2, len(e) - 1)))
-    return e, out
+        out.append((key, read_int(row[4], f"boxes[{n}] code", -3 - (len(w) - 1), len(e) - 1)))
+    return e, w, out
 
 
 def _check_tiling(keys: set, deepest: int) -> None:
@@ -245,9 +295,57 @@ def _sink_groups(keys: set, sinks: list, deepest: int) -> int:
     return len({root(k) for k in sinks})
 
 
+_AROUND = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)]
+
+
+def _check_cuts(model: ArbModel, domain, deepest: int) -> None:
+    """What the pieces need of the domain: strictly increasing finest cuts, a strict phi excess."""
+    for n, (lo, hi) in enumerate(domain):
+        step = math.ldexp(hi - lo, -deepest)
+        # each cut lo + i * step is within one ulp of 2 M of its real value; a step above 4 such ulps keeps them apart
+        if not step > 4 * math.ulp(2 * max(abs(lo), abs(hi), hi - lo)):
+            raise Refused(f"domain axis {n}: the finest slices are too thin for their float cuts to increase strictly")
+    pl, ph = domain[2]
+    excess = arb(ph) - arb(pl) - 2 * arb.pi()
+    first, last = arb(_cut(pl, ph, deepest, 1)) - arb(pl), arb(ph) - arb(_cut(pl, ph, deepest, (1 << deepest) - 1))
+    if not (excess < first and excess < last):
+        raise Refused("domain: for the pieces, the phi range must exceed 2 pi by less than its first and last slices")
+
+
+def _separate_pieces(keys: set, rows: list) -> int:
+    """The number of pieces (contact components of the non-OUT boxes; phi wraps) that hold a sink.
+
+    Two closed boxes of a tiling meet exactly when, for one of the 26 offsets d, the cell of the
+    finer one's level beside it along d lies in the coarser one: each box looks along every d for
+    the box holding that cell at its own level or above (the finer boxes beside it find it in turn).
+    """
+    keep = {key for key, code in rows if not _is_out(code)}
+    parent = {k: k for k in keep}
+
+    def root(k):
+        while parent[k] != k:
+            parent[k] = parent[parent[k]]
+            k = parent[k]
+        return k
+
+    for key in keep:
+        lev, n = key[0], 1 << key[0]
+        for d in _AROUND:
+            c = [key[1] + d[0], key[2] + d[1], (key[3] + d[2]) % n]
+            if not (0 <= c[0] < n and 0 <= c[1] < n):
+                continue
+            for up in range(lev + 1):
+                k = (lev - up, c[0] >> up, c[1] >> up, c[2] >> up)
+                if k in keys:
+                    if k in parent and k != key:
+                        parent[root(k)] = root(key)
+                    break
+    return len({root(k) for k, code in rows if code == _SINK})
+
+
 def _check_order(keys: set, rows: list, dirs: list, deepest: int) -> None:
     """Every box across an exit face of a retracting box is OUT, a sink or an earlier retracting box."""
-    resolved = {key for key, code in rows if code < 0}
+    resolved = {key for key, code in rows if code < 0}  # OUT (plain or by a combination) and sinks
     for key, code in rows:
         if code < 0:
             continue
@@ -271,7 +369,7 @@ def check_aspect_connected(model: ArbModel, claim: dict, prec: int) -> tuple[str
     """
     aspect, sign = read_aspect(claim)
     domain = read_hex_box(get(claim, "domain"), "domain")
-    dirs, rows = _read_rows(claim)
+    dirs, combos, rows = _read_rows(claim)
     deepest = max(k[0] for k, _ in rows)
     keys = {k for k, _ in rows}
     if len(keys) != len(rows):
@@ -279,12 +377,15 @@ def check_aspect_connected(model: ArbModel, claim: dict, prec: int) -> tuple[str
     _check_domain(model, domain, deepest)
     _check_tiling(keys, deepest)
     sinks = [k for k, code in rows if code == _SINK]
-    empty = all(code == _OUT for _, code in rows)
+    empty = all(_is_out(code) for _, code in rows)
     groups = _sink_groups(keys, sinks, deepest)
+    pieces = 0
     if not empty:
         if not sinks:
             raise Refused("no sink box: the retractions have nowhere to end")
         _check_order(keys, rows, dirs, deepest)
+        _check_cuts(model, domain, deepest)
+        pieces = _separate_pieces(keys, rows)
     evec = [(arb(a), arb(b), arb(c) / div) for a, b, c, div in dirs]
     for key, code in rows:
         box = _box(domain, key)
@@ -292,6 +393,10 @@ def check_aspect_connected(model: ArbModel, claim: dict, prec: int) -> tuple[str
             ok, what = holds_on_box(box, lambda s: _beyond_or_opposite(model, s, sign)), f"free of {aspect}"
         elif code == _SINK:
             ok, what = holds_on_box(box, lambda s: _in_aspect(model, s, sign)), f"inside {aspect}"
+        elif code <= -3:
+            w = combos[-3 - code]
+            ok = holds_on_box(box, lambda s: combination_negative(model, s, sign, w))
+            what = f"free of {aspect} by the combination {list(w)}"
         else:
             ok = holds_on_box(box, lambda s: retracts(model, s, sign, evec[code]))
             what = f"retracting along {list(dirs[code][:3])}"
@@ -299,9 +404,15 @@ def check_aspect_connected(model: ArbModel, claim: dict, prec: int) -> tuple[str
             raise Refused(f"box {list(key)}: not proved {what}")
     if empty:
         return f"every box of the cover is proved free of {aspect}: {aspect} is empty", \
-            {"aspect_sign": sign, "components_at_most": 0}
+            {"aspect_sign": sign, "components_at_most": 0, "components_at_least": 0}
     n_ret = sum(1 for _, code in rows if code >= 0)
-    what = "nonempty and connected" if groups == 1 else f"nonempty, with at most {groups} components"
+    if groups == 1:
+        what = "nonempty and connected"
+    elif pieces == groups:
+        what = f"nonempty, with exactly {groups} components (each group of sinks in its own piece)"
+    else:
+        what = f"nonempty, with at least {pieces} and at most {groups} components"
     return (f"{aspect} is {what}: {len(rows)} boxes tile the domain ({len(sinks)} sinks inside {aspect}, in "
             f"{groups} face-connected group(s); {n_ret} retract along certified monotone directions onto them in "
-            f"order; the rest are free of {aspect})"), {"aspect_sign": sign, "components_at_most": groups}
+            f"order; the rest are free of {aspect}; the boxes not free of it make {pieces} separate piece(s) holding "
+            f"sinks)"), {"aspect_sign": sign, "components_at_most": groups, "components_at_least": pieces}

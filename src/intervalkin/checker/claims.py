@@ -243,7 +243,9 @@ def check_claim(geometry: Geometry, kind: str, claim: dict, precision: int = 128
 def count_bound(name: str, support: list[dict]) -> int:
     """The lower bound the verified support proves (proofs/lemma-checker.md, section counts).
 
-    * ``aspects``: number of distinct det A signs among verified aspect_distinct boxes.
+    * ``aspects``: for each sign of det A, the larger of 1 when a verified aspect_distinct box has
+      it and the ``components_at_least`` of its verified aspect_connected claim (pieces of the
+      non-OUT boxes holding sinks, proofs/lemma-aspect-retraction.md); summed over the signs.
     * ``basic_regions``: over verified complete solves of joint vectors strictly
       inside the joint limits, the sum over their distinct aspect splits
       (n_wa1, n_wa2) of n_wa1 + n_wa2 (Theorem 1 and the constant-split lemma;
@@ -255,7 +257,8 @@ def count_bound(name: str, support: list[dict]) -> int:
         signs: set = set()
         for f in support:
             signs |= f.get("signs", set())
-        return len(signs)
+        pieces = {f["aspect_sign"]: int(f.get("components_at_least", 0)) for f in support if "aspect_sign" in f}
+        return sum(max(1 if s in signs else 0, pieces.get(s, 0)) for s in (1, -1))
     solves = [f for f in support if f.get("complete") and f.get("in_limits")]
     if name == "basic_regions":
         splits = {(f["n_wa1"], f["n_wa2"]) for f in solves}

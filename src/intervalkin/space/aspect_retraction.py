@@ -15,13 +15,16 @@ proofs/lemma-aspect-retraction.md.
 :func:`classify_boxes` labels boxes for one sign, in bulk:
 
 * OUT: no point of S in the box (a leg certified beyond a limit, or det A
-  certified of sign -s on the whole box);
+  certified of sign -s on the whole box), or, where several constraint surfaces
+  pass near the box and none of them alone excludes it, a combination
+  sum_j w_j f_j with integer weights w_j >= 0 certified < 0 on the box (then at
+  every point some f_j with w_j > 0 is negative: the point is not in S);
 * IN: the box lies in S (every constraint certified satisfied);
 * otherwise, the candidate directions e for which the retraction condition is
   certified: the fixed directions :data:`DIRECTIONS` and two directions built per
   box from the midpoint gradients of its undecided constraints (their sum, and
-  the least-norm e with g_j . e = 1 for each normalised gradient), rounded to the
-  same integer grid.
+  the least-norm e with g_j . e = 1 for each normalised gradient), rounded to a
+  finer integer grid (:data:`FINE_GRID`).
 
 Directions are integer triples (a, b, c) standing for e = (a, b, c / PHI_DIVISOR):
 exact numbers, so that the certificate and the checker use the very e the library
@@ -41,6 +44,7 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.constants import constants
+from intervalkin.kinematics.formulas import approx_det_a, approx_rho_sq
 from intervalkin.kinematics.enclosures import (
     det_a_gradient_interval,
     det_a_interval,
@@ -48,7 +52,8 @@ from intervalkin.kinematics.enclosures import (
     rho_sq_interval,
 )
 
-__all__ = ["PHI_DIVISOR", "GRID", "DIRECTIONS", "BoxRetraction", "exit_faces", "classify_boxes", "shared_direction"]
+__all__ = ["PHI_DIVISOR", "GRID", "FINE_GRID", "WEIGHT_GRID", "DIRECTIONS", "BoxRetraction", "exit_faces",
+           "classify_boxes", "shared_direction", "shared_directions", "constraint_values", "approx_free_of_aspect"]
 
 #: e = (a, b, c / PHI_DIVISOR): a turn of the platform moves its points about 20 times further than
 #: a unit shift, so the phi component is scaled down to balance the gradients.
@@ -59,8 +64,15 @@ PHI_DIVISOR = 16
 MARGIN = 0.05
 #: Boxes of this level and deeper are decided without a margin (the checker's forms are tight enough there).
 MARGIN_LEVEL = 8
-#: Largest |component| of a direction built per box (its components are rounded to this grid).
+#: Largest |component| of a fixed direction.
 GRID = 16
+#: Largest |component| of a direction built per box or per cluster (its components are rounded to this grid).
+#: Finer than GRID: where three constraint surfaces meet with nearly dependent gradients the valid directions
+#: form a cone a few hundredths of a radian wide, which may hold no point of the coarse grid.
+FINE_GRID = 256
+#: Smallest positive weight of a combination of constraints proving a box OUT (weights are integers, exact,
+#: below 2**40; the gradients of rho_i^2 and det A differ by orders of magnitude, so the largest may be far above).
+WEIGHT_GRID = 256
 
 
 def _fixed_directions() -> np.ndarray:
@@ -96,6 +108,8 @@ class BoxRetraction:
     """Labels of n boxes for one sign of det A.
 
     ``out`` (n,): no point of the aspect's set S in the box; ``inside`` (n,): the box lies in S;
+    ``weights`` (n, 7) int: on an OUT box proved by a combination, its weights w_j >= 0 on the seven
+    constraints (sum_j w_j f_j < 0 on the box), else 0;
     ``ok`` (n, m + 2): the retraction condition is certified along candidate direction j (the fixed
     :data:`DIRECTIONS` first, then the two per-box directions ``custom`` (n, 2, 3)); rows of ``out``
     and ``inside`` boxes are all False (an IN box needs no condition: every direction retracts it).
@@ -105,13 +119,14 @@ class BoxRetraction:
     inside: np.ndarray
     ok: np.ndarray
     custom: np.ndarray
+    weights: np.ndarray
 
 
 def _to_grid(v: np.ndarray) -> np.ndarray:
-    """Real directions (..., 3) in scaled coordinates -> integer triples, largest component GRID."""
+    """Real directions (..., 3) in scaled coordinates -> integer triples, largest component FINE_GRID."""
     s = np.max(np.abs(v), axis=-1, keepdims=True)
     s = np.where(s > 0, s, 1.0)
-    return np.rint(v / s * GRID).astype(np.int64)
+    return np.rint(v / s * FINE_GRID).astype(np.int64)
 
 
 def _custom_directions(grads: np.ndarray, active: np.ndarray) -> np.ndarray:
@@ -190,15 +205,180 @@ def classify_boxes(geometry: Geometry, boxes: np.ndarray, sign: int) -> BoxRetra
     n, nd = len(boxes), len(DIRECTIONS)
     ok = np.zeros((n, nd + 2), dtype=bool)
     custom = np.zeros((n, 2, 3), dtype=np.int64)
+    weights = np.zeros((n, 7), dtype=np.int64)
     idx = np.flatnonzero(~out & ~inside)
     if idx.size == 0:
-        return BoxRetraction(out, inside, ok, custom)
+        return BoxRetraction(out, inside, ok, custom, weights)
     grads = gradients(idx)
     own = _custom_directions(_midpoints(grads), opened[idx])
     ok[idx, :nd] = _certified(grads, opened[idx], DIRECTIONS, mu[idx])
     ok[idx, nd:] = _certified(grads, opened[idx], own, mu[idx])
     custom[idx] = own
-    return BoxRetraction(out, inside, ok, custom)
+    stuck = ~np.any(ok[idx], axis=1) & (opened[idx].sum(axis=1) >= 2)
+    if np.any(stuck):
+        rows = idx[stuck]
+        w, proved = _combination_out(geometry, boxes[rows], sign, opened[rows],
+                                     [Interval(g.lo[stuck], g.hi[stuck]) for g in grads], mu[rows])
+        out[rows[proved]] = True
+        ok[rows[proved]] = False
+        weights[rows[proved]] = w[proved]
+    return BoxRetraction(out, inside, ok, custom, weights)
+
+
+def constraint_values(geometry: Geometry, boxes: np.ndarray, sign: int) -> Interval:
+    """Enclosures (n, 7) of the seven constraints f_j over boxes (n, 3, 2), in the order of the module docstring."""
+    k = constants(geometry)
+    r = rho_sq_interval(geometry, boxes)
+    sd = det_a_interval(geometry, boxes) * float(sign)
+    low, high = r - k.rho_min_sq_iv, k.rho_max_sq_iv - r
+    return Interval(np.concatenate([low.lo, high.lo, sd.lo[:, None]], axis=1),
+                    np.concatenate([low.hi, high.hi, sd.hi[:, None]], axis=1))
+
+
+def _combination_out(geometry: Geometry, boxes: np.ndarray, sign: int, opened: np.ndarray, grads: list[Interval],
+                     mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Integer weights w (n, 7) >= 0 on the open constraints, and where sum_j w_j f_j < 0 is certified (n,).
+
+    Where the gradients of the open constraints are nearly dependent with nonnegative weights (two or
+    three constraint surfaces nearly tangent, S pinched away), the combination is nearly constant
+    over a small box, and its sign is decided by a centred form: F(m) + sum_k [dF/dx_k](B) ([B_k] - m_k),
+    m the box's midpoint (float), F(m) enclosed on the point box [m, m].  The weights minimise
+    |sum_j v_j g_j| over sum_j v_j = 1 (g_j the scaled, normalised midpoint gradients; floats),
+    kept when nonnegative and rounded to integers (exact); the certification comes after.
+    """
+    n = len(boxes)
+    scale = np.array([1.0, 1.0, 1.0 / PHI_DIVISOR])
+    g = _midpoints(grads) * scale  # (n, 7, 3)
+    norm = np.linalg.norm(g, axis=-1)
+    use = opened & (norm > 0)
+    gn = np.where(use[..., None], g / np.where(norm > 0, norm, 1.0)[..., None], 0.0)
+    h = gn @ np.swapaxes(gn, 1, 2) + np.where(use, 1e-9, 1e9)[:, None, :] * np.eye(7)[None]
+    v = np.linalg.solve(h, np.ones((n, 7, 1)))[..., 0]
+    v = np.where(use, v, 0.0)
+    v /= np.where(np.abs(v.sum(axis=1, keepdims=True)) > 0, v.sum(axis=1, keepdims=True), 1.0)
+    lam = np.where(use, v / np.where(norm > 0, norm, 1.0), 0.0)
+    good = np.all(lam >= -1e-12, axis=1) & (np.count_nonzero(lam > 0, axis=1) >= 2)
+    lam = np.where(lam > 1e-9 * np.max(lam, axis=1, keepdims=True), lam, 0.0)
+    least = np.min(np.where(lam > 0, lam, np.inf), axis=1, keepdims=True)
+    w = np.rint(lam / np.where(np.isfinite(least), least, 1.0) * WEIGHT_GRID)
+    good &= np.all(w < 2.0**40, axis=1)
+    w = np.where(good[:, None], w, 0).astype(np.int64)
+    proved = np.zeros(n, dtype=bool)
+    rows = np.flatnonzero(np.any(w > 0, axis=1))
+    if rows.size == 0:
+        return w, proved
+    b = boxes[rows]
+    m = 0.5 * (b[:, :, 0] + b[:, :, 1])
+    wf = w[rows].astype(np.float64)  # exact: small integers
+    at_m = constraint_values(geometry, np.stack([m, m], axis=-1), sign)
+    total = Interval(np.zeros(rows.size), np.zeros(rows.size))
+    for j in range(7):
+        total = total + Interval(at_m.lo[:, j], at_m.hi[:, j]) * wf[:, j]
+    for k in range(3):
+        dk = Interval(np.zeros(rows.size), np.zeros(rows.size))
+        for j in range(7):
+            dk = dk + Interval(grads[j].lo[rows, k], grads[j].hi[rows, k]) * wf[:, j]
+        total = total + dk * (Interval(b[:, k, 0], b[:, k, 1]) - Interval(m[:, k], m[:, k]))
+    proved[rows] = np.nan_to_num(total.hi + mu[rows] * (total.hi - total.lo), nan=1.0) < 0
+    return w, proved
+
+
+def shared_direction(geometry: Geometry, boxes: np.ndarray, sign: int) -> tuple[np.ndarray, np.ndarray]:
+    """One direction for a cluster of boxes (n, 3, 2), and where it is certified (n,) bool.
+
+    Near a corner of the aspect (three constraint surfaces meeting) the valid directions form
+    a narrow cone, and directions chosen box by box may send neighbours at each other.  One
+    direction for the whole cluster cannot: every step then moves forward along it.  It is the
+    least-norm solution of g_j . e = 1 over the open constraints, g_j their normalised midpoint
+    gradients averaged over the cluster.  :func:`shared_directions` does many clusters at once.
+    """
+    e, ok = shared_directions(geometry, boxes, sign, np.zeros(len(boxes), dtype=np.int64))
+    return e[0], ok
+
+
+def shared_directions(geometry: Geometry, boxes: np.ndarray, sign: int,
+                      cluster: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`shared_direction` for every cluster at once: ``cluster`` (n,) ids 0..c-1 -> (e (c, 3), ok (n,))."""
+    n = len(boxes)
+    nc = int(cluster.max()) + 1 if n else 0
+    e = np.zeros((nc, 3), dtype=np.int64)
+    ok = np.zeros(n, dtype=bool)
+    out, inside, opened, gradients, mu = _constraints(geometry, boxes, sign)
+    idx = np.flatnonzero(~out & ~inside)
+    if idx.size == 0:
+        return e, ok
+    grads = gradients(idx)
+    g = _midpoints(grads) * np.array([1.0, 1.0, 1.0 / PHI_DIVISOR])
+    norm = np.linalg.norm(g, axis=-1, keepdims=True)
+    g = np.where(opened[idx][..., None] & (norm > 0), g / np.where(norm > 0, norm, 1.0), 0.0)
+    sums = np.zeros((nc, 7, 3))
+    np.add.at(sums, cluster[idx], g)
+    used = np.zeros((nc, 7), dtype=np.int64)
+    np.add.at(used, cluster[idx], opened[idx].astype(np.int64))
+    for c in np.flatnonzero(np.any(used > 0, axis=1)):
+        mean = sums[c][used[c] > 0]
+        mean /= np.maximum(np.linalg.norm(mean, axis=-1, keepdims=True), 1e-300)
+        e[c] = _to_grid(np.linalg.pinv(mean) @ np.ones(len(mean)))
+    ok[idx] = _certified(grads, opened[idx], e[cluster[idx]][:, None, :], mu[idx])[:, 0]
+    return e, ok
+
+
+def constraint_values(geometry: Geometry, boxes: np.ndarray, sign: int) -> Interval:
+    """Enclosures (n, 7) of the seven constraints f_j over boxes (n, 3, 2), in the order of the module docstring."""
+    k = constants(geometry)
+    r = rho_sq_interval(geometry, boxes)
+    sd = det_a_interval(geometry, boxes) * float(sign)
+    low, high = r - k.rho_min_sq_iv, k.rho_max_sq_iv - r
+    return Interval(np.concatenate([low.lo, high.lo, sd.lo[:, None]], axis=1),
+                    np.concatenate([low.hi, high.hi, sd.hi[:, None]], axis=1))
+
+
+def _combination_out(geometry: Geometry, boxes: np.ndarray, sign: int, opened: np.ndarray, grads: list[Interval],
+                     mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Integer weights w (n, 7) >= 0 on the open constraints, and where sum_j w_j f_j < 0 is certified (n,).
+
+    Where the gradients of the open constraints are nearly dependent with nonnegative weights (two or
+    three constraint surfaces nearly tangent, S pinched away), the combination is nearly constant
+    over a small box, and its sign is decided by a centred form: F(m) + sum_k [dF/dx_k](B) ([B_k] - m_k),
+    m the box's midpoint (float), F(m) enclosed on the point box [m, m].  The weights minimise
+    |sum_j v_j g_j| over sum_j v_j = 1 (g_j the scaled, normalised midpoint gradients; floats),
+    kept when nonnegative and rounded to integers (exact); the certification comes after.
+    """
+    n = len(boxes)
+    scale = np.array([1.0, 1.0, 1.0 / PHI_DIVISOR])
+    g = _midpoints(grads) * scale  # (n, 7, 3)
+    norm = np.linalg.norm(g, axis=-1)
+    use = opened & (norm > 0)
+    gn = np.where(use[..., None], g / np.where(norm > 0, norm, 1.0)[..., None], 0.0)
+    h = gn @ np.swapaxes(gn, 1, 2) + np.where(use, 1e-9, 1e9)[:, None, :] * np.eye(7)[None]
+    v = np.linalg.solve(h, np.ones((n, 7, 1)))[..., 0]
+    v = np.where(use, v, 0.0)
+    v /= np.where(np.abs(v.sum(axis=1, keepdims=True)) > 0, v.sum(axis=1, keepdims=True), 1.0)
+    lam = np.where(use, v / np.where(norm > 0, norm, 1.0), 0.0)
+    good = np.all(lam >= -1e-12, axis=1) & (np.count_nonzero(lam > 0, axis=1) >= 2)
+    lam = np.where(lam > 1e-9 * np.max(lam, axis=1, keepdims=True), lam, 0.0)
+    least = np.min(np.where(lam > 0, lam, np.inf), axis=1, keepdims=True)
+    w = np.rint(lam / np.where(np.isfinite(least), least, 1.0) * WEIGHT_GRID)
+    good &= np.all(w < 2.0**40, axis=1)
+    w = np.where(good[:, None], w, 0).astype(np.int64)
+    proved = np.zeros(n, dtype=bool)
+    rows = np.flatnonzero(np.any(w > 0, axis=1))
+    if rows.size == 0:
+        return w, proved
+    b = boxes[rows]
+    m = 0.5 * (b[:, :, 0] + b[:, :, 1])
+    wf = w[rows].astype(np.float64)  # exact: small integers
+    at_m = constraint_values(geometry, np.stack([m, m], axis=-1), sign)
+    total = Interval(np.zeros(rows.size), np.zeros(rows.size))
+    for j in range(7):
+        total = total + Interval(at_m.lo[:, j], at_m.hi[:, j]) * wf[:, j]
+    for k in range(3):
+        dk = Interval(np.zeros(rows.size), np.zeros(rows.size))
+        for j in range(7):
+            dk = dk + Interval(grads[j].lo[rows, k], grads[j].hi[rows, k]) * wf[:, j]
+        total = total + dk * (Interval(b[:, k, 0], b[:, k, 1]) - Interval(m[:, k], m[:, k]))
+    proved[rows] = np.nan_to_num(total.hi + mu[rows] * (total.hi - total.lo), nan=1.0) < 0
+    return w, proved
 
 
 def shared_direction(geometry: Geometry, boxes: np.ndarray, sign: int) -> tuple[np.ndarray, np.ndarray]:
@@ -225,3 +405,23 @@ def shared_direction(geometry: Geometry, boxes: np.ndarray, sign: int) -> tuple[
     e = _to_grid(np.linalg.pinv(mean) @ np.ones(int(used.sum())))
     ok[idx] = _certified(grads, opened[idx], e[None, :], mu[idx])[:, 0]
     return e, ok
+
+
+def approx_free_of_aspect(geometry: Geometry, boxes: np.ndarray, sign: int, points: int = 5) -> np.ndarray:
+    """Float screen, NOT certified: True where none of points**3 grid points of a box (n, 3, 2) lies in S.
+
+    Used only to choose which boxes to refine (where OUT boxes may cut two groups of sinks apart);
+    never a label.  Cost: points**3 float evaluations per box.
+    """
+    lo2 = np.array([float(v) ** 2 for v in geometry.rho_min])
+    hi2 = np.array([float(v) ** 2 for v in geometry.rho_max])
+    t = np.linspace(0.0, 1.0, points)
+    grid = np.stack(np.meshgrid(t, t, t, indexing="ij"), axis=-1).reshape(-1, 3)
+    free = np.ones(len(boxes), dtype=bool)
+    for start in range(0, len(boxes), 4096):
+        b = boxes[start:start + 4096]
+        p = b[:, None, :, 0] + grid[None] * (b[:, None, :, 1] - b[:, None, :, 0])
+        r = approx_rho_sq(geometry, p)
+        ins = np.all((r >= lo2) & (r <= hi2), axis=-1) & (sign * approx_det_a(geometry, p) > 0)
+        free[start:start + 4096] = ~np.any(ins, axis=1)
+    return free

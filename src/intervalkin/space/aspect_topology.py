@@ -1,36 +1,48 @@
-"""The number of aspects, bounded from above: each sign's part of W minus {det A = 0} proved connected.
+"""The number of aspects, bounded from both sides: each sign's part of W minus {det A = 0}, its components counted.
 
 For a sign s let S_s = {X in W : s det A(X) > 0} (WA1 for s = +1, WA2 for s = -1).
 The aspects are the connected components of S_+ and of S_-, so
 
-    number of aspects = c(S_+) + c(S_-),   c = number of connected components,
+    number of aspects = c(S_+) + c(S_-),   c = number of connected components.
 
-and the count is exact (= 2) when both sets are proved nonempty and connected.
 :func:`prove_aspects` builds, for each sign, a COVER of the paving domain by octree
 boxes (integer coordinates, as in :mod:`intervalkin.paving.tree`), each box one of
 
-* OUT: certified free of S_s;
-* SINK: certified inside S_s; the sinks form ONE face-connected set of boxes;
+* OUT: certified free of S_s (one constraint certified violated on the box, or a
+  nonnegative combination of the constraints certified negative);
+* SINK: certified inside S_s; the sinks form face-connected GROUPS (few: one per
+  component of S_s when the proof closes);
 * RET(e): the retraction condition of :mod:`intervalkin.space.aspect_retraction`
   holds along e, and every box across an exit face of e is OUT, a SINK, or a RET
   box of lower rank (the ranks make the chains acyclic);
 * LEFT: none of these could be proved (reported: location and volume).
 
-Lemma (proofs/lemma-aspect-retraction.md): with no LEFT box, every point of S_s is
-joined inside S_s to the sinks, whose union is connected: S_s is connected.  An IN
-box that is not a sink needs no condition of its own (every direction retracts it),
-so small fragments of IN boxes are joined to the sinks through their exit faces:
-the joins of fragments and the absence of hidden pieces come from one argument.
+Upper bound (proofs/lemma-aspect-retraction.md): with no LEFT box, every point of
+S_s is joined inside S_s to a group of sinks, each of which is connected: S_s has at
+most as many components as there are groups.  An IN box that is not a sink needs no
+condition of its own (every direction retracts it), so small fragments of IN boxes
+are joined to the sinks through their exit faces.
+
+Lower bound (same lemma, "Separations"): the closed boxes that are not OUT hold all
+of S_s; the components of their union (boxes meeting at a face, an edge or a corner,
+phi wrapping) are disjoint closed PIECES, so each piece holding a sink holds its own
+components of S_s.  When every group of sinks lies in its own piece, the count of
+each sign is exact, whatever it is (the second design, examples/second_design_0246.toml,
+has two components of each sign: 4 aspects).
 
 How the cover is built: boxes are split top-down while neither OUT, IN nor
 retractable (up to ``start_depth``); then ranks are computed by a fixed point over
 the face adjacency (a worklist: each rank looks only at the boxes beside those
 resolved at the rank before); clusters of unresolved boxes get one shared direction
-(corners of S_s), and what is still unresolved is split and re-classified, up to
-``max_depth``.  Only the unresolved boxes are refined, so the cover stays small
-(about 20 000 boxes per sign for the paper's manipulator, where the depth-8 paving
-has millions): the independent checker re-proves every box of it in arb.  Cost on
-the paper's manipulator: about 1 s per sign.
+(corners of S_s), again while a pass resolves an eighth of what is left.  What one group of sinks cannot
+reach is resolved with more groups (the largest unreached fragment of IN boxes first,
+up to MAX_GROUPS); where two groups share a piece, the boxes the first group could not
+reach are refined while that joins groups, then the boxes where the groups' regions
+meet and those a float screen finds free of S_s (a cut by OUT boxes is found there;
+the screen only chooses what to split).  Refinement goes up to ``max_depth``.  Only
+these boxes are refined, so the cover stays small (about 20 000 boxes per sign for the
+paper's manipulator, where the depth-8 paving has millions): the independent checker
+re-proves every box of it in arb.  Cost on the paper's manipulator: about 1 s per sign.
 """
 
 from __future__ import annotations
@@ -42,12 +54,18 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.status import Count
-from intervalkin.paving.adjacency import component_labels, shares_face
+from intervalkin.paving.adjacency import component_labels, grow_labels, shares_face, touching_pairs
 from intervalkin.paving.tree import box_bounds, split_boxes, workspace_paving_domain
-from intervalkin.space.aspect_retraction import DIRECTIONS, classify_boxes, exit_faces, shared_direction
+from intervalkin.space.aspect_retraction import (
+    DIRECTIONS,
+    approx_free_of_aspect,
+    classify_boxes,
+    exit_faces,
+    shared_directions,
+)
 
 __all__ = ["OUT", "SINK", "RET", "LEFT", "AspectCover", "AspectTopology", "face_pairs", "resolve_cover",
-           "cover_aspect", "prove_aspects"]
+           "separations", "cover_aspect", "prove_aspects"]
 
 #: Kinds of the boxes of a cover.
 OUT, SINK, RET, LEFT = 0, 1, 2, 3
@@ -55,6 +73,11 @@ OUT, SINK, RET, LEFT = 0, 1, 2, 3
 MAX_ROUNDS = 12
 #: No refinement round that would take a cover past this many boxes (what is unresolved then is reported).
 MAX_BOXES = 200_000
+#: Passes of shared directions per round: a cluster's direction is averaged over all its boxes; once part of
+#: it is resolved, the rest (often one corner of S) gets a direction of its own.
+SHARE_PASSES = 4
+#: Share again only when the last pass resolved at least this fraction of the boxes left.
+SHARE_GAIN = 0.125
 #: Most groups of sinks a cover may use when one group cannot be reached from everywhere.
 MAX_GROUPS = 8
 
@@ -65,9 +88,13 @@ class AspectCover:
 
     ``level`` (n,), ``ijk`` (n, 3): the boxes; ``kind`` (n,): OUT, SINK, RET or LEFT;
     ``direction`` (n, 3) int: e = (a, b, c / PHI_DIVISOR) of RET boxes (0 elsewhere);
+    ``weights`` (n, 7) int: on OUT boxes proved by a combination sum_j w_j f_j < 0 of the seven
+    constraints, its weights (0 elsewhere; None: no such box);
     ``rank`` (n,): 0 for OUT and SINK, the step at which a RET box was resolved, -1 for LEFT.
     ``fragments``: face-connected components of IN boxes (before the joins by retraction).
     ``groups``: face-connected groups of sinks (each is connected; every point reaches one).
+    ``separated``: components of the union of the closed non-OUT boxes (boxes meeting at a face, an
+    edge or a corner; phi wraps) that hold a sink: S_s has at least that many components.
     ``connected``: no LEFT box and one group of sinks: S_s is proved nonempty and connected.
     ``empty``: every box is OUT: S_s is proved empty.
     """
@@ -81,7 +108,9 @@ class AspectCover:
     rank: np.ndarray
     fragments: int
     groups: int
+    separated: int
     seconds: float
+    weights: np.ndarray | None = None
 
     @property
     def closed(self) -> bool:
@@ -92,6 +121,18 @@ class AspectCover:
     def components_at_most(self) -> int | None:
         """The proved upper bound on the number of components of S_s (None: the cover is open)."""
         return self.groups if self.closed else None
+
+    @property
+    def components_at_least(self) -> int:
+        """The proved lower bound on the number of components of S_s: the sinks lie in S_s, and the OUT boxes,
+        free of it, split the rest of the domain into ``separated`` pieces that each hold a sink."""
+        return self.separated
+
+    @property
+    def exact(self) -> bool:
+        """The number of components of S_s is proved: the cover is closed and each group of sinks is cut off
+        from the others by OUT boxes."""
+        return self.closed and self.separated == self.groups
 
     @property
     def connected(self) -> bool:
@@ -115,8 +156,11 @@ class AspectCover:
     def to_json(self) -> dict:
         kinds = {name: int(np.count_nonzero(self.kind == v)) for name, v in
                  (("out", OUT), ("sink", SINK), ("retract", RET), ("left", LEFT))}
+        kinds["out_by_combination"] = 0 if self.weights is None else int(np.count_nonzero(np.any(self.weights > 0, 1)))
         return {"sign": self.sign, "boxes": int(len(self.level)), "kinds": kinds, "inside_fragments": self.fragments,
-                "sink_groups": self.groups, "components_at_most": self.components_at_most, "connected": self.connected, "empty": self.empty, "deepest_level": int(self.level.max()),
+                "sink_groups": self.groups, "components_at_most": self.components_at_most,
+                "components_at_least": self.components_at_least, "connected": self.connected, "empty": self.empty,
+                "deepest_level": int(self.level.max()),
                 "longest_chain": int(self.rank.max()), "seconds": round(self.seconds, 3),
                 "leftovers": self.leftovers()[:20]}
 
@@ -137,19 +181,39 @@ class AspectTopology:
     def seconds(self) -> float:
         return sum(c.seconds for c in self.covers)
 
+    def lower(self, found: Count) -> int:
+        """The lower bound of ``found`` (distinct signs) raised by the separations of the closed covers.
+
+        A sign witnessed by ``found`` counts 1 there; its closed cover proves ``separated`` components,
+        so it adds ``separated - 1`` (a sign not witnessed by ``found`` is then under-counted by one:
+        still a lower bound, and the checker's own bound is never below it).
+        """
+        return found.lower + sum(max(c.separated - 1, 0) for c in self.covers if c.closed)
+
     def count(self, found: Count) -> Count:
-        """The aspect count ``found`` (its lower bound from opposite signs) with this upper bound added."""
-        upper = self.upper
-        if upper is None or upper < found.found:
+        """The aspect count ``found`` (its lower bound from opposite signs) with the covers' bounds added.
+
+        ``found`` is raised to the proved lower bound when the separations prove more aspects than
+        the library's components of certified boxes of each sign found.
+        """
+        upper, lower = self.upper, self.lower(found)
+        n = max(found.found, lower)
+        per_sign = ", ".join(f"{'WA1' if c.sign > 0 else 'WA2'} {c.components_at_least}.."
+                             f"{c.components_at_most if c.closed else '?'}" for c in self.covers)
+        if upper is None or upper < n:
             left = sum(len(c.leftovers()) for c in self.covers)
-            return Count(found.found, found.lower, None, False, found.why + f"; the covers of the two signs leave "
-                         f"{left} boxes undecided (listed under \"covers\"), so no upper bound is proved")
+            return Count(n, lower, None, False, found.why + f"; components per sign {per_sign}; the covers of the two "
+                         f"signs leave {left} boxes undecided (listed under \"covers\"), so no upper bound is proved")
         groups = " + ".join(str(c.groups) for c in self.covers)
-        return Count(found.found, found.lower, upper, upper == found.lower,
-                     f"at least {found.lower}: opposite certified signs of det A; at most {upper} = {groups}: for each "
-                     "sign, a cover of the domain by boxes free of it, inside it (face-connected groups of sinks) or "
-                     "retracting onto the sinks along certified monotone directions proves that its part of W has at "
-                     "most one component per group (proofs/lemma-aspect-retraction.md)")
+        cut = lower > found.lower
+        return Count(n, lower, upper, upper == lower,
+                     f"at least {lower}: opposite certified signs of det A"
+                     + (", and OUT boxes of the covers cutting a sign's part of W into pieces that each hold "
+                        "a sink" if cut else "")
+                     + f"; at most {upper} = {groups}: for each sign, a cover of the domain by boxes free of it, "
+                     "inside it (face-connected groups of sinks) or retracting onto the sinks along certified "
+                     "monotone directions proves that its part of W has at most one component per group "
+                     f"(components per sign: {per_sign}; proofs/lemma-aspect-retraction.md)")
 
     def to_json(self) -> dict:
         return {"upper_bound": self.upper, "covers": {("WA1" if c.sign > 0 else "WA2"): c.to_json()
@@ -187,7 +251,7 @@ def face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int) -> tuple[np.ndarr
     return pairs, border, edges
 
 
-def resolve_cover(level, ijk, depth, out, inside, ok, custom_faces, volume, max_groups: int = 1):
+def resolve_cover(level, ijk, depth, out, inside, ok, custom_faces, volume, max_groups: int = 1, adjacency=None):
     """Sinks, ranks and chosen candidates of the boxes of one cover (numpy fixed point).
 
     The sinks are the face-connected component of IN boxes of largest volume; other IN boxes
@@ -196,9 +260,10 @@ def resolve_cover(level, ijk, depth, out, inside, ok, custom_faces, volume, max_
     (each group is connected; the set is then proved to have at most that many components).
     Returns (kind, rank, choice, fragments, edges, groups); ``choice`` indexes the candidate
     directions (-1: none), LEFT boxes are those no rank reached, ``edges`` the face adjacency.
+    ``adjacency``: :func:`face_pairs` of the boxes when already computed.
     """
     n = len(level)
-    pairs, border, edges = face_pairs(level, ijk, depth)
+    pairs, border, edges = face_pairs(level, ijk, depth) if adjacency is None else adjacency
     comp = component_labels(n, edges, inside)
     fragments = int(comp.max()) + 1 if np.any(inside) else 0
     frag_vol = np.bincount(comp[inside], weights=volume[inside], minlength=fragments)
@@ -251,6 +316,42 @@ def resolve_cover(level, ijk, depth, out, inside, ok, custom_faces, volume, max_
     return kind, rank, choice, fragments, edges, groups
 
 
+def separations(level: np.ndarray, ijk: np.ndarray, depth: int, out: np.ndarray, sink: np.ndarray,
+                edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, np.ndarray]:
+    """Where OUT boxes cut the sinks apart: (piece (n,), group (n,), separated, touching (2, m)).
+
+    ``piece``: component of the union of the closed non-OUT boxes (boxes that meet at a face, an
+    edge or a corner, :func:`~intervalkin.paving.adjacency.touching_pairs`; phi wraps), -1 on OUT
+    boxes; ``group``: face-connected group of sinks (``edges``: face adjacency), -1 elsewhere;
+    ``separated``: number of pieces holding a sink; ``touching``: the pairs of non-OUT boxes that meet.
+    The pieces are closed, pairwise disjoint and cover S (the OUT boxes hold none of it): a piece
+    holding a sink holds its own components of S, so S has at least ``separated`` components
+    (proofs/lemma-aspect-retraction.md, "Separations").
+    """
+    touching = touching_pairs(level, ijk, depth, ~out)
+    piece = component_labels(len(level), touching, ~out)
+    group = component_labels(len(level), edges, sink)
+    return piece, group, len(np.unique(piece[sink])), touching
+
+
+def _between_groups(kind: np.ndarray, piece: np.ndarray, group: np.ndarray, touching: np.ndarray,
+                    pieces: np.ndarray) -> np.ndarray:
+    """Boxes (not sinks) where the regions nearest to two groups of sinks meet, inside the given pieces.
+
+    Each non-OUT box of the pieces takes the group nearest to it in the touching graph; the boxes
+    touching a box of another group are where a join (refined IN boxes) or a cut (refined OUT
+    boxes) between the groups must be found.
+    """
+    inc = np.isin(piece, pieces)
+    near = grow_labels(len(kind), touching, np.where(inc, group, -1), inc)
+    a, b = touching
+    meet = (near[a] >= 0) & (near[b] >= 0) & (near[a] != near[b])
+    out = np.zeros(len(kind), dtype=bool)
+    out[a[meet]] = True
+    out[b[meet]] = True
+    return out & (kind != SINK)
+
+
 def _classified(geometry, domain, level, ijk, sign):
     """Labels of boxes given by integer coordinates, with room for a third per-box direction (shared)."""
     lo, hi = box_bounds(domain, level, ijk)
@@ -258,19 +359,35 @@ def _classified(geometry, domain, level, ijk, sign):
     n = len(level)
     ok = np.concatenate([c.ok, np.zeros((n, 1), dtype=bool)], axis=1)
     custom = np.concatenate([c.custom, np.zeros((n, 1, 3), dtype=np.int64)], axis=1)
-    return [c.out, c.inside, ok, custom, np.prod(hi - lo, axis=1)]
+    return [c.out, c.inside, ok, custom, np.prod(hi - lo, axis=1), c.weights]
 
 
 def _share_directions(geometry, domain, level, ijk, kind, edges, sign, ok, custom) -> None:
     """Give each face-connected cluster of LEFT boxes one shared direction where it is certified (in place)."""
     left = kind == LEFT
-    comp = component_labels(len(level), edges, left)
-    for c in range(int(comp.max()) + 1 if np.any(left) else 0):
-        rows = np.flatnonzero(comp == c)
-        lo, hi = box_bounds(domain, level[rows], ijk[rows])
-        e, good = shared_direction(geometry, np.stack([lo, hi], axis=-1), sign)
-        custom[rows[good], 2] = e
-        ok[rows[good], -1] = True
+    if not np.any(left):
+        return
+    rows = np.flatnonzero(left)
+    comp = component_labels(len(level), edges, left)[rows]
+    lo, hi = box_bounds(domain, level[rows], ijk[rows])
+    e, good = shared_directions(geometry, np.stack([lo, hi], axis=-1), sign, comp)
+    custom[rows[good], 2] = e[comp[good]]
+    ok[rows[good], -1] = True
+
+
+def _resolve_shared(geometry, domain, level, ijk, depth, sign, out, inside, ok, custom, vol, max_groups):
+    """:func:`resolve_cover`, then shared directions for the clusters left, again while that helps (in place)."""
+    adjacency = face_pairs(level, ijk, depth)
+    res = resolve_cover(level, ijk, depth, out, inside, ok, exit_faces(custom), vol, max_groups, adjacency)
+    for _ in range(SHARE_PASSES):
+        left = int(np.count_nonzero(res[0] == LEFT))
+        if left == 0:
+            break
+        _share_directions(geometry, domain, level, ijk, res[0], res[4], sign, ok, custom)
+        res = resolve_cover(level, ijk, depth, out, inside, ok, exit_faces(custom), vol, max_groups, adjacency)
+        if np.count_nonzero(res[0] == LEFT) > (1 - SHARE_GAIN) * left:  # again only while a pass pays
+            break
+    return res
 
 
 def cover_aspect(geometry: Geometry, sign: int, start_depth: int = 9, max_depth: int = 12) -> AspectCover:
@@ -292,34 +409,50 @@ def cover_aspect(geometry: Geometry, sign: int, start_depth: int = 9, max_depth:
         if not np.any(cut):
             break
         level, ijk = split_boxes(level[cut], ijk[cut])
-    level, ijk, out, inside, ok, custom, vol = (np.concatenate(p) for p in zip(*parts))
+    level, ijk, out, inside, ok, custom, vol, weights = (np.concatenate(p) for p in zip(*parts))
+    unjoined_before = 1 << 30  # groups of sinks sharing a piece with another group, at the round before
     for rnd in range(MAX_ROUNDS + 1):
         depth = max(int(level.max()), 1)
-        faces = exit_faces(custom)
-        kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, depth, out, inside, ok, faces, vol)
-        if np.any(kind == LEFT):
-            _share_directions(geometry, domain, level, ijk, kind, edges, sign, ok, custom)
-            faces = exit_faces(custom)
-            kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, depth, out, inside, ok,
-                                                                         faces, vol)
-        cut = (kind == LEFT) & (level < max_depth)
+        args = (geometry, domain, level, ijk, depth, sign, out, inside, ok, custom, vol)
+        kind, rank, choice, fragments, edges, groups = one = _resolve_shared(*args, 1)
+        crowded = np.zeros(len(level), dtype=bool)
+        if np.any(kind == LEFT) and np.any(inside & (kind == LEFT)):
+            # more groups of sinks where one group does not reach everything; a group cut off from the others by
+            # OUT boxes is another component (no refinement can join it); where two groups share a piece of the
+            # non-OUT boxes, the boxes one group could not reach are refined, in the hope of a join
+            kind, rank, choice, fragments, edges, groups = _resolve_shared(*args, MAX_GROUPS)
+        separated = groups  # one group: in one piece (and none: S is empty or the cover open)
+        if groups > 1:
+            piece, group, separated, touching = separations(level, ijk, depth, out, kind == SINK, edges)
+            holding = np.unique(piece[group >= 0])
+            per_piece = np.array([len(np.unique(group[(piece == p) & (group >= 0)])) for p in holding])
+            many = holding[per_piece > 1]
+            if many.size:
+                unjoined = int(per_piece[per_piece > 1].sum())
+                if unjoined < unjoined_before:  # refine what one group cannot reach, while that joins groups
+                    crowded = (one[0] == LEFT) & np.isin(piece, many)
+                else:  # else refine where the groups' regions meet and where S seems absent: a join or a cut
+                    crowded = _between_groups(kind, piece, group, touching, many) & ~inside
+                    maybe = np.flatnonzero(np.isin(piece, many) & ~inside & (kind != SINK))
+                    lo, hi = box_bounds(domain, level[maybe], ijk[maybe])
+                    crowded[maybe] |= approx_free_of_aspect(geometry, np.stack([lo, hi], axis=-1), sign)
+                unjoined_before = unjoined
+        cut = ((kind == LEFT) | crowded) & (level < max_depth)
         if rnd == MAX_ROUNDS or not np.any(cut) or len(level) + 7 * int(cut.sum()) > MAX_BOXES:
-            if np.any(kind == LEFT):  # what one group of sinks cannot reach: more groups (a weaker bound)
-                kind, rank, choice, fragments, edges, groups = resolve_cover(level, ijk, depth, out, inside, ok,
-                                                                             faces, vol, MAX_GROUPS)
             break
         cl, cijk = split_boxes(level[cut], ijk[cut])
         lab = _classified(geometry, domain, cl, cijk, sign)
         keep = ~cut
         level, ijk = np.concatenate([level[keep], cl]), np.concatenate([ijk[keep], cijk])
-        out, inside, ok, custom, vol = (np.concatenate([a[keep], b]) for a, b in zip((out, inside, ok, custom, vol), lab))
+        out, inside, ok, custom, vol, weights = (np.concatenate([a[keep], b]) for a, b in
+                                                 zip((out, inside, ok, custom, vol, weights), lab))
     direction = np.zeros((len(level), 3), dtype=np.int64)
     rows = np.flatnonzero(kind == RET)
     j = choice[rows]
     m = len(DIRECTIONS)
     direction[rows] = np.where((j < m)[:, None], DIRECTIONS[np.minimum(j, m - 1)], custom[rows, np.clip(j - m, 0, 2)])
     return AspectCover(sign, domain, level.astype(np.int64), ijk, kind, direction, rank, fragments, groups,
-                       time.perf_counter() - t0)
+                       separated, time.perf_counter() - t0, weights)
 
 
 def prove_aspects(geometry: Geometry, start_depth: int = 9, max_depth: int = 12) -> AspectTopology:
