@@ -86,7 +86,7 @@ def test_counts_are_copied_with_their_bounds(killed_run):
         for name in ("aspects", "joint_cells", "basic_regions", "uniqueness_domains"):
             assert r[f"{name}_lower"] <= r[f"{name}_found"]
             assert r[f"{name}_exact"] == (r[f"{name}_upper"] is not None and r[f"{name}_upper"] == r[f"{name}_lower"])
-        assert r["aspects_lower"] == 2  # both det A signs are certified around the paper's manipulator
+        assert r["aspects_lower"] >= 2  # both det A signs are certified; a separation may prove more
         assert 0 <= r["volume_largest_uniqueness_domain"] <= r["volume_W"]
         assert r["seconds"] > 0 and r["memory_mb"] > 0
     table = result.table()

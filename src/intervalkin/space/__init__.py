@@ -1,11 +1,15 @@
 """space/: the paper's definition sets, built on certified pavings and solves.
 
 aspect                  components of W of one certified sign of det A
+aspect_retraction       certified monotone directions (and OUT by combinations) of boxes of one sign's set
+aspect_cover_graph      face pairs, retraction ranks and separations of an aspect cover
+aspect_topology         covers of each sign: the number of aspects with lower and upper bounds
 singular_surface        the singular layer of the workspace and the image g(S)
 joint_space             joint cells off an outer enclosure of g(S) (voxel grid)
 joint_paving            joint space paved directly: boxes proved off g(S), adaptive (solve.joint_box)
 joint_cells             the cells of that paving, their certified counts, joins, regions from cells
 joint_pieces            the two pieces of each fold box (solve.fold_model) and the points that join them to cells
+joint_models            the local models of the undecided leaves (exclusion, fold), computed once per leaf
 characteristic_surface  aspect boxes certified off S_c
 pieces, sheets, voxel_paths   pieces of certified boxes and the sheet above a cell each lies on
 basic_region            basic regions and basic components (Theorem 1, Proposition 1)
