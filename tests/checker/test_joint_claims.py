@@ -163,6 +163,21 @@ def test_cover_refuses_a_pose_box_away_from_the_singular_poses(paper_geometry, m
     assert torus_search(model, box, turned.tolist())[0]
 
 
+def test_cover_refuses_half_pose_boxes(paper_geometry, models):
+    """Mutation test of the cover by excluded slabs (small cells straddling a face of the pose box): the pose box
+    cut at its middle in any coordinate, on either side, leaves singular poses of the box out, and is refused."""
+    ctx.prec = 128
+    model = ArbModel(paper_geometry)
+    for c in models[:3]:
+        box, pose = read_joint_box(c["box"]), np.array(c["pose"])
+        assert torus_search(model, box, pose.tolist())[0]
+        for a in range(3):
+            for side in (0, 1):
+                cut = pose.copy()
+                cut[a, 1 - side] = pose[a].mean()
+                assert not torus_search(model, box, cut.tolist())[0], (c["id"], a, side)
+
+
 def test_changed_axis_is_refused(paper_geometry, fold_paving, models):
     """The library tries the axes in order and keeps the first that passes: an earlier axis is refused."""
     tried = 0

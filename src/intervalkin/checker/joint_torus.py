@@ -16,7 +16,9 @@ R_1, so a cover of the torus (theta, phi) by cells Theta x Phi gives pose boxes
   (:func:`~intervalkin.checker.joint_exclusion.excluded`): no singular pose with its joint
   vector in R lies in the cell;
 * *covered* (only when a pose box X is given) when P(R, C), shifted by 2 pi m for
-  some m in -2..2, lies inside X.
+  some m in -2..2, lies inside X, or (small cells only) when, for such a shift meeting X,
+  every closed slab of P(R, C) outside one face of X is excluded as above: the cell's
+  singular poses with joint vector in R then lie in X (up to the shift).
 
 :func:`torus_search` bisects the cells (theta or phi, whichever moves the pose more)
 until each is discarded or covered, within a budget.  All discarded: R does not meet
@@ -105,8 +107,32 @@ class _Search:
         d = self._det_centred(t, p)
         if d > 0 or d < 0:
             return True
-        small = th[1] - th[0] < EXCLUSION_WIDTH and ph[1] - ph[0] < EXCLUSION_WIDTH
-        return small and excluded(self.model, [x, y, p], self.r_sq)
+        if not (th[1] - th[0] < EXCLUSION_WIDTH and ph[1] - ph[0] < EXCLUSION_WIDTH):
+            return False
+        if excluded(self.model, [x, y, p], self.r_sq):
+            return True
+        return self.pose is not None and self._outside_excluded(x, y, p)
+
+    def _outside_excluded(self, x, y, p) -> bool:
+        """PROVED: every singular pose of the cell with g in R has a 2 pi-translate in X.
+
+        For a shift s with p + s meeting X's phi range, each point of the cell (phi shifted by
+        s) outside X lies in one of the closed slabs {coordinate a <= lo_a} or {>= hi_a} of the
+        cell's box; every such slab is excluded (det A and rho^2 are 2 pi-periodic in phi)."""
+        for sh in self.shifts:
+            box = [x, y, p + sh]
+            if not all(v.overlaps(arb.union(lo, hi)) for v, (lo, hi) in zip(box, self.pose)):
+                continue
+            slabs = []
+            for a, (lo, hi) in enumerate(self.pose):
+                v = box[a]
+                if not v.lower() >= lo:
+                    slabs.append(box[:a] + [arb.union(v.lower(), lo)] + box[a + 1:])
+                if not v.upper() <= hi:
+                    slabs.append(box[:a] + [arb.union(hi, v.upper())] + box[a + 1:])
+            if all(excluded(self.model, b, self.r_sq) for b in slabs):
+                return True
+        return False
 
     def run(self, budget: int) -> tuple[bool, str]:
         tc = [-TOP + 2 * TOP * k / THETA_CELLS for k in range(THETA_CELLS + 1)]
