@@ -163,21 +163,6 @@ def test_cover_refuses_a_pose_box_away_from_the_singular_poses(paper_geometry, m
     assert torus_search(model, box, turned.tolist())[0]
 
 
-def test_cover_refuses_half_pose_boxes(paper_geometry, models):
-    """Mutation test of the cover by excluded slabs (small cells straddling a face of the pose box): the pose box
-    cut at its middle in any coordinate, on either side, leaves singular poses of the box out, and is refused."""
-    ctx.prec = 128
-    model = ArbModel(paper_geometry)
-    for c in models[:3]:
-        box, pose = read_joint_box(c["box"]), np.array(c["pose"])
-        assert torus_search(model, box, pose.tolist())[0]
-        for a in range(3):
-            for side in (0, 1):
-                cut = pose.copy()
-                cut[a, 1 - side] = pose[a].mean()
-                assert not torus_search(model, box, cut.tolist())[0], (c["id"], a, side)
-
-
 def test_changed_axis_is_refused(paper_geometry, fold_paving, models):
     """The library tries the axes in order and keeps the first that passes: an earlier axis is refused."""
     tried = 0
@@ -375,40 +360,6 @@ def test_library_clear_boxes_are_re_proved(paper_geometry, fold_paving):
     for i in np.concatenate([rng.choice(searched, 20, replace=False), rng.choice(voided, 40, replace=False)]):
         ok, why = torus_search(model, _fr_box(np.stack([pav.lo[i], pav.hi[i]], -1)))
         assert ok, (i, why)
-
-
-@settings(max_examples=30, deadline=None)
-@given(st.floats(-20, 25), st.floats(-3.1, 3.1), st.sampled_from([1e-2, 1e-4, 1e-7]))
-def test_exclusion_never_discards_a_cell_holding_a_singular_pose(x, phi, width):
-    """Mutation test of the exclusion: a pose box holding a bracketed singular pose (det A changes sign along y,
-    proved in arb), with a joint box enclosing the joint vectors of the whole bracket (arb), is never excluded;
-    the same box with the joint box moved off those joint vectors is (the test can fail both ways)."""
-    from intervalkin.checker.joint_exclusion import excluded
-    from intervalkin.core.geometry import default_geometry
-
-    g = default_geometry()
-    ys = np.linspace(-25.0, 25.0, 4001)
-    det = approx_det_a(g, np.stack([np.full_like(ys, x), ys, np.full_like(ys, phi)], axis=1))
-    change = np.flatnonzero(np.sign(det[:-1]) * np.sign(det[1:]) < 0)
-    if change.size == 0:
-        return
-    ctx.prec = 128
-    model = ArbModel(g)
-    y0 = ys[change[0]]
-    a, b = y0 - width, y0 + width
-    while True:  # shrink the bracket towards the sign change of the float samples, keeping it proved
-        da, db = model.det(arb(x), arb(a), arb(phi)), model.det(arb(x), arb(b), arb(phi))
-        if (da < 0 and db > 0) or (da > 0 and db < 0):
-            break
-        a, b = a - width, b + width
-        if b - a > 1.0:
-            return
-    seg = [arb(x), arb.union(arb(a), arb(b)), arb(phi)]
-    r_sq = [v.union(v) for v in model.rho_sq(*seg)]  # every joint vector of the bracket, squared
-    X = [arb.union(arb(x - width), arb(x + width)), seg[1], arb.union(arb(phi - width), arb(phi + width))]
-    assert not excluded(model, X, r_sq, rounds=8), (x, phi, width)
-    far = [v + 4 * (v.rad() + 1) for v in r_sq]  # the joint box moved off: no pose of X reaches it
-    assert excluded(model, X, far), (x, phi, width)
 
 
 def test_side_test_agrees_with_the_library_and_with_solves(paper_geometry, fold_paving, models, facts):
