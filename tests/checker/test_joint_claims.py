@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import copy
 import json
+import re
 from fractions import Fraction
 
 import numpy as np
@@ -345,13 +346,20 @@ def test_boxes_around_singular_images_are_never_clear(x, phi, width):
 
 
 def test_library_clear_boxes_are_re_proved(paper_geometry, fold_paving):
+    """Clear leaves of both kinds, re-proved by the checker's torus search: those the library cleared by its own
+    torus search, and those it cleared by Krawczyk exclusion (``voided``), which the checker re-proves with its
+    own exclusion of small cells (proofs/lemma-clear-joint-box.md, point 5)."""
     pav = fold_paving.paving
-    clear = np.flatnonzero(pav.labels["clear"] == Label.INSIDE)
+    clear = pav.labels["clear"] == Label.INSIDE
+    voided = np.flatnonzero(fold_paving.voided)
+    assert voided.size >= 100 and clear[voided].all()
+    searched = np.flatnonzero(clear & ~fold_paving.voided)
     ctx.prec = 128
     model = ArbModel(paper_geometry)
-    for i in np.random.default_rng(3).choice(clear, 25, replace=False):
+    rng = np.random.default_rng(3)
+    for i in np.concatenate([rng.choice(searched, 20, replace=False), rng.choice(voided, 40, replace=False)]):
         ok, why = torus_search(model, _fr_box(np.stack([pav.lo[i], pav.hi[i]], -1)))
-        assert ok, why
+        assert ok, (i, why)
 
 
 def test_side_test_agrees_with_the_library_and_with_solves(paper_geometry, fold_paving, models, facts):
@@ -385,19 +393,22 @@ def test_side_test_agrees_with_the_library_and_with_solves(paper_geometry, fold_
 
 
 def test_component_joins_link_clear_components(paper_geometry):
-    """Without join levels, at depth 6, one cell of the paper's manipulator is three face-connected groups of
-    clear boxes that only fold pieces join: the two component joins come first, end in clear boxes of two
-    different groups, and verify (about 15 s: the depth-6 paving)."""
+    """Without join levels, at depth 6, cells of the paper's manipulator are several face-connected groups of
+    clear boxes that only fold pieces join (with the local models, fold and voided boxes along g(S), there are
+    dozens): the writer plans one component join per group beyond the first of each cell, and the two written
+    come first, end in clear boxes of two different groups of one cell, and verify (about 30 s: the paving)."""
     from intervalkin.certify.joint_claims import joint_claims
     from intervalkin.paving.adjacency import component_labels, shares_face
     from intervalkin.space.joint_paving import pave_joint_space
 
     jsp = pave_joint_space(paper_geometry, 6, 0, fold=True)
     models, joins, omitted = joint_claims(paper_geometry, jsp, max_joins=2, max_models=8)
-    assert len(joins) == 2 and "2 joining clear components" in omitted[-1]["what"]
     pav = jsp.paving
     clear = jsp.cell >= 0
     comp = component_labels(len(pav), shares_face(pav.level, pav.ijk, int(pav.level.max()), (False,) * 3), clear)
+    extra = sum(np.unique(comp[clear & (jsp.cell == c)]).size - 1 for c in np.unique(jsp.cell[clear]))
+    planned = re.search(r"(\d+) joining clear components", omitted[-1]["what"])
+    assert len(joins) == 2 and planned and int(planned.group(1)) == extra >= 2, (extra, omitted[-1])
     leaf_of = {tuple((float(a), float(b)) for a, b in zip(pav.lo[i], pav.hi[i])): i for i in np.flatnonzero(clear)}
     facts = {f"{MODELS}#{c['id']}": run_check(paper_geometry, "joint_fold_model", c, 128)[1] for c in models}
     for j in joins:

@@ -29,6 +29,7 @@ Modules: :mod:`~intervalkin.checker.parse` (reading fields exactly),
 (box labels), :mod:`~intervalkin.checker.solutions` (direct kinematics),
 :mod:`~intervalkin.checker.aspects` and :mod:`~intervalkin.checker.taylor` (aspect covers),
 :mod:`~intervalkin.checker.trajectory` (motions), :mod:`~intervalkin.checker.joint_torus`,
+:mod:`~intervalkin.checker.joint_exclusion` (Krawczyk exclusion of small torus cells),
 :mod:`~intervalkin.checker.joint_models` and :mod:`~intervalkin.checker.joint_join` (fold models
 and joins of the joint paving), :mod:`~intervalkin.checker.claims`
 (one check per kind, counts), :mod:`~intervalkin.checker.consistency` (counts against
@@ -92,7 +93,8 @@ Re-proved per claim type
     two connected pieces (proofs/lemma-joint-claims.md).
 ``joint_join``
     The two ends declare one count and split, and each witness's complete solution list
-    proves it; every clear node is re-proved off g(S) by the torus search, every fold
+    proves it; every clear node is re-proved off g(S) by the torus search (small undecided
+    cells discarded by Krawczyk exclusion, proofs/lemma-clear-joint-box.md), every fold
     node is a verified ``joint_fold_model`` claim of the folder; each witness and link
     lies strictly inside the joint limits and in its node(s) (the side test for pieces):
     both witnesses lie in one component of the joint box minus g(S).

@@ -31,6 +31,7 @@ from fractions import Fraction
 
 from flint import arb, arb_mat
 
+from intervalkin.checker.joint_exclusion import leg_sq
 from intervalkin.checker.joint_torus import JointBox, torus_search
 from intervalkin.checker.model import ArbModel, balls, exact_ball
 from intervalkin.checker.parse import Refused, get, parse_exact, read_box, read_int
@@ -78,20 +79,6 @@ def in_joint_box(q, box: JointBox) -> bool:
 
 def _others(k: int) -> tuple[int, int]:
     return tuple(a for a in range(3) if a != k)  # type: ignore[return-value]
-
-
-def _leg(model: ArbModel, l: int):
-    """rho_l^2 as a function of (x, y, phi) with products only (for hyper-dual arguments)."""
-    ax, ay = model.A[l]
-
-    def f(x, y, phi):
-        if l == 0:
-            ux, uy = x - ax, y - ay
-        else:
-            rx, ry = model.rot_polar(phi, l)
-            ux, uy = x + rx - ax, y + ry - ay
-        return ux * ux + uy * uy
-    return f
 
 
 def _span(lo: Fraction, hi: Fraction):
@@ -144,7 +131,7 @@ class FoldProof:
     def _derivative(self, X) -> list[list]:
         """E'(X) over balls X: the gradients of rho_i^2, rho_j^2 and det A, each partial derivative the
         natural form intersected with its mean-value form (:func:`~intervalkin.checker.taylor.slope_enclosure`)."""
-        fs = (_leg(self.model, self.i), _leg(self.model, self.j), self.model.det)
+        fs = (leg_sq(self.model, self.i), leg_sq(self.model, self.j), self.model.det)
         return [[slope_enclosure(f, X, e) for e in _UNIT] for f in fs]
 
     def image(self, X: list, P: tuple) -> list:
@@ -168,7 +155,7 @@ class FoldProof:
 
     def height_sq(self, P: tuple):
         """An enclosure of h^2 = rho_k^2(X*(p)) over the parameter balls P (natural form ∩ second-order Taylor form)."""
-        return value_enclosure(_leg(self.model, self.k), self.contract(P))
+        return value_enclosure(leg_sq(self.model, self.k), self.contract(P))
 
     def side(self, q) -> int:
         """-1 when q_k < h(q_i, q_j) is PROVED, +1 when q_k > h is, 0 undecided (q: exact, inside R)."""

@@ -10,10 +10,15 @@ R_1, so a cover of the torus (theta, phi) by cells Theta x Phi gives pose boxes
 
 * *discarded* when rho_2^2 or rho_3^2 over P(R, C) misses R_2^2 or R_3^2, or det A
   over P(R, C) has a proved sign (natural form, then the centred form in the
-  variables (rho_1, theta, phi) of :func:`~intervalkin.checker.taylor.centred_enclosure`):
-  no singular pose with its joint vector in R lies in the cell;
+  variables (rho_1, theta, phi) of :func:`~intervalkin.checker.taylor.centred_enclosure`),
+  or, for a cell still undecided and narrower than ``EXCLUSION_WIDTH`` on both sides, when
+  Krawczyk exclusion proves P(R, C) free of singular poses with joint vector in R
+  (:func:`~intervalkin.checker.joint_exclusion.excluded`): no singular pose with its joint
+  vector in R lies in the cell;
 * *covered* (only when a pose box X is given) when P(R, C), shifted by 2 pi m for
-  some m in -2..2, lies inside X.
+  some m in -2..2, lies inside X, or (small cells only) when, for such a shift meeting X,
+  every closed slab of P(R, C) outside one face of X is excluded as above: the cell's
+  singular poses with joint vector in R then lie in X (up to the shift).
 
 :func:`torus_search` bisects the cells (theta or phi, whichever moves the pose more)
 until each is discarded or covered, within a budget.  All discarded: R does not meet
@@ -30,6 +35,7 @@ from fractions import Fraction
 
 from flint import arb
 
+from intervalkin.checker.joint_exclusion import excluded
 from intervalkin.checker.model import ArbModel, exact_ball, interval_ball
 from intervalkin.checker.taylor import centred_enclosure
 
@@ -41,6 +47,9 @@ THETA_CELLS, PHI_CELLS = 16, 24
 TORUS_BUDGET = 30000
 #: A cell narrower than this (radians, both sides) that is still undecided stops the search at once.
 MIN_WIDTH = 1e-9
+#: An undecided cell narrower than this (radians, both sides) is also tried by Krawczyk exclusion
+#: (:func:`~intervalkin.checker.joint_exclusion.excluded`); wider cells are only bisected.
+EXCLUSION_WIDTH = 1e-2
 #: A float just above pi: the cells cover [-TOP, TOP]^2, which holds [-pi, pi]^2 (checked in arb below).
 TOP = math.nextafter(math.pi, math.inf)
 
@@ -61,6 +70,7 @@ class _Search:
         self.a1x, self.a1y = model.A[0]
         self.reach = max(float(v.upper()) for v in model.L) + 1.0
         self.r1_hi = float(box[0][1])
+        self.r_sq = [arb.union(lo, hi) for lo, hi in zip(self.lo2, self.hi2)]
         self.pose = None
         if pose is not None:
             self.pose = [(arb(lo), arb(hi)) for lo, hi in pose]
@@ -95,7 +105,34 @@ class _Search:
         if self.pose is not None and self._covered(x, y, p):
             return True
         d = self._det_centred(t, p)
-        return bool(d > 0 or d < 0)
+        if d > 0 or d < 0:
+            return True
+        if not (th[1] - th[0] < EXCLUSION_WIDTH and ph[1] - ph[0] < EXCLUSION_WIDTH):
+            return False
+        if excluded(self.model, [x, y, p], self.r_sq):
+            return True
+        return self.pose is not None and self._outside_excluded(x, y, p)
+
+    def _outside_excluded(self, x, y, p) -> bool:
+        """PROVED: every singular pose of the cell with g in R has a 2 pi-translate in X.
+
+        For a shift s with p + s meeting X's phi range, each point of the cell (phi shifted by
+        s) outside X lies in one of the closed slabs {coordinate a <= lo_a} or {>= hi_a} of the
+        cell's box; every such slab is excluded (det A and rho^2 are 2 pi-periodic in phi)."""
+        for sh in self.shifts:
+            box = [x, y, p + sh]
+            if not all(v.overlaps(arb.union(lo, hi)) for v, (lo, hi) in zip(box, self.pose)):
+                continue
+            slabs = []
+            for a, (lo, hi) in enumerate(self.pose):
+                v = box[a]
+                if not v.lower() >= lo:
+                    slabs.append(box[:a] + [arb.union(v.lower(), lo)] + box[a + 1:])
+                if not v.upper() <= hi:
+                    slabs.append(box[:a] + [arb.union(hi, v.upper())] + box[a + 1:])
+            if all(excluded(self.model, b, self.r_sq) for b in slabs):
+                return True
+        return False
 
     def run(self, budget: int) -> tuple[bool, str]:
         tc = [-TOP + 2 * TOP * k / THETA_CELLS for k in range(THETA_CELLS + 1)]
