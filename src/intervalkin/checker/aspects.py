@@ -45,7 +45,7 @@ from typing import Callable
 from flint import arb
 
 from intervalkin.checker.labels import holds_on_box
-from intervalkin.checker.model import ArbModel, balls
+from intervalkin.checker.model import ArbModel, balls, leg_sq
 from intervalkin.checker.parse import Refused, get, read_aspect, read_hex_box, read_int
 from intervalkin.checker.taylor import centred_enclosure, slope_enclosure, value_enclosure
 
@@ -61,21 +61,6 @@ _OUT, _SINK = -1, -2
 def _is_out(code: int) -> bool:
     """OUT (-1) or OUT by a combination (-3 - c)."""
     return code == _OUT or code <= -3
-
-
-def _leg(model: ArbModel, i: int) -> Callable:
-    """rho_i^2 as a function of (x, y, phi), written with products only (for hyper-dual arguments)."""
-    ax, ay = model.A[i]
-
-    def f(x, y, phi):
-        if i == 0:
-            ux, uy = x - ax, y - ay
-        else:
-            rx, ry = model.rot_polar(phi, i)
-            ux, uy = x + rx - ax, y + ry - ay
-        return ux * ux + uy * uy
-
-    return f
 
 
 def _signed(v, sign: int) -> bool:
@@ -99,7 +84,7 @@ def _beyond_or_opposite(model: ArbModel, b, sign: int) -> bool:
     if model.beyond_limits(r) or _has_sign(model.det, box, -sign):
         return True
     for i in range(3):
-        leg, lo2, hi2 = _leg(model, i), model.rmin2[i], model.rmax2[i]
+        leg, lo2, hi2 = leg_sq(model, i), model.rmin2[i], model.rmax2[i]
         if _has_sign(lambda *x: leg(*x) - hi2, box, 1, r[i] - hi2) or \
                 _has_sign(lambda *x: lo2 - leg(*x), box, 1, lo2 - r[i]):
             return True
@@ -116,7 +101,7 @@ def _in_aspect(model: ArbModel, b, sign: int) -> bool:
         low, high = bool(r[i] >= model.rmin2[i]), bool(r[i] <= model.rmax2[i])
         if low and high:
             continue
-        t = value_enclosure(_leg(model, i), box)
+        t = value_enclosure(leg_sq(model, i), box)
         if not ((low or t >= model.rmin2[i]) and (high or t <= model.rmax2[i])):
             return False
     return True
@@ -133,7 +118,7 @@ def retracts(model: ArbModel, b, sign: int, e) -> bool:
         low, high = bool(r[i] >= model.rmin2[i]), bool(r[i] <= model.rmax2[i])
         if low and high:
             continue
-        leg = _leg(model, i)
+        leg = leg_sq(model, i)
         slope = slope_enclosure(leg, box, e)
         low, high = low or bool(slope >= 0), high or bool(slope <= 0)
         if low and high:
@@ -157,7 +142,7 @@ def combination_negative(model: ArbModel, b, sign: int, w) -> bool:
     At each point of the box some f_j with w_j > 0 is then negative: the point is not in S.
     Natural form, then the first- and second-order Taylor forms.
     """
-    legs = [_leg(model, i) for i in range(3)]
+    legs = [leg_sq(model, i) for i in range(3)]
     wa = [arb(v) for v in w]
     rest = sum(wa[3 + i] * model.rmax2[i] - wa[i] * model.rmin2[i] for i in range(3))
 

@@ -25,29 +25,15 @@ from __future__ import annotations
 
 from flint import arb, arb_mat
 
-from intervalkin.checker.model import ArbModel
+from intervalkin.checker.model import ArbModel, leg_sq
 from intervalkin.checker.taylor import slope_enclosure
 
-__all__ = ["EXCLUSION_ROUNDS", "leg_sq", "excluded"]
+__all__ = ["EXCLUSION_ROUNDS", "excluded"]
 
 #: Intersections X <- X ∩ K_0 ∩ K_1 ∩ K_2 tried before the box is given up (left undecided).
 EXCLUSION_ROUNDS = 4
 _ZERO, _ONE = arb(0), arb(1)
 _UNIT = ((_ONE, _ZERO, _ZERO), (_ZERO, _ONE, _ZERO), (_ZERO, _ZERO, _ONE))
-
-
-def leg_sq(model: ArbModel, l: int):
-    """rho_l^2 as a function of (x, y, phi) with products only (for hyper-dual arguments)."""
-    ax, ay = model.A[l]
-
-    def f(x, y, phi):
-        if l == 0:
-            ux, uy = x - ax, y - ay
-        else:
-            rx, ry = model.rot_polar(phi, l)
-            ux, uy = x + rx - ax, y + ry - ay
-        return ux * ux + uy * uy
-    return f
 
 
 def _inverse_mid(J: list):

@@ -31,9 +31,8 @@ from fractions import Fraction
 
 from flint import arb, arb_mat
 
-from intervalkin.checker.joint_exclusion import leg_sq
 from intervalkin.checker.joint_torus import JointBox, torus_search
-from intervalkin.checker.model import ArbModel, balls, exact_ball
+from intervalkin.checker.model import ArbModel, balls, exact_ball, leg_sq
 from intervalkin.checker.parse import Refused, get, parse_exact, read_box, read_int
 from intervalkin.checker.taylor import slope_enclosure, value_enclosure
 

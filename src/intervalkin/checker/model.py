@@ -24,7 +24,7 @@ from flint import arb, fmpq
 
 from intervalkin.core.geometry import Geometry
 
-__all__ = ['ArbModel', 'exact_ball', 'interval_ball', 'balls', 'has_sign']
+__all__ = ['ArbModel', 'exact_ball', 'interval_ball', 'balls', 'has_sign', 'leg_sq']
 
 def exact_ball(v: Fraction):
     """The rational ``v`` as a ball (exact when the precision allows, else a tight enclosure)."""
@@ -152,3 +152,17 @@ class ArbModel:
             ax, ay = self.A[i]
             m.append((2 * (rx - (ax - a1x)), 2 * (ry - (ay - a1y))))
         return m[0][0] * m[1][1] - m[0][1] * m[1][0]
+
+
+def leg_sq(model: ArbModel, l: int):
+    """rho_l^2 as a function of (x, y, phi) with products only (for hyper-dual arguments)."""
+    ax, ay = model.A[l]
+
+    def f(x, y, phi):
+        if l == 0:
+            ux, uy = x - ax, y - ay
+        else:
+            rx, ry = model.rot_polar(phi, l)
+            ux, uy = x + rx - ax, y + ry - ay
+        return ux * ux + uy * uy
+    return f
