@@ -181,7 +181,7 @@ class Analysis:
         aspects = counts.aspects if self.aspect_topology is None else self.aspect_topology.count(counts.aspects)
         return dataclasses.replace(counts, aspects=aspects,
                                    basic_regions=regions_from_cells(self.cells.cells, counts.basic_regions.lower,
-                                                                                    _joint_undecided(self.cells)))
+                                                                                    self.cells.open_places()))
 
     def label(self, pose: Sequence, refine: bool = True) -> PoseLabel:
         """Certified aspect, basic region and uniqueness domain of a pose (x, y, phi), read exactly.
@@ -251,16 +251,6 @@ class VerifyReport:
     def failed(self) -> tuple[CheckResult, ...]:
         """The claims that were not re-proved."""
         return tuple(r for r in self.results if not r.verified)
-
-
-def _joint_undecided(jp: JointSpacePaving) -> dict:
-    """What the direct joint paving leaves open: the volume of undecided boxes, fragments, unjoined fold pieces."""
-    fs = jp.fold_stats
-    return {"joint_volume": jp.undecided_volume(), "joint_certified_share": jp.certified_share(),
-            "fragments": [{"count": c.count, "volume": c.volume, "witness": [str(v) for v in c.witness]}
-                          for c in jp.fragments],
-            "unjoined_fold_pieces": {"groups": int(fs.get("unjoined_piece_groups", 0)),
-                                     "volume": float(fs.get("unjoined_piece_volume", 0.0))}}
 
 
 def check_chain_depth(depth, refine_to=None) -> int:

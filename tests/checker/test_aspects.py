@@ -21,7 +21,8 @@ from intervalkin.certify.aspect_claims import aspect_connected_claims
 from intervalkin.checker import check_claim
 import networkx as nx
 
-from intervalkin.checker.aspects import _box, _separate_pieces, _sink_groups, retracts
+from intervalkin.checker.aspect_tiling import sink_groups
+from intervalkin.checker.aspects import _box, pieces_holding_sinks, retracts
 from intervalkin.checker.labels import holds_on_box
 from intervalkin.checker.claims import check_count, count_bound, count_upper
 from intervalkin.checker.model import ArbModel, balls
@@ -181,7 +182,7 @@ def test_the_second_design_has_exactly_four_aspects(second_geometry, second_clai
         assert "exactly 2 components" in why
         keys = {tuple(r[:4]) for r in claim["boxes"]}
         rows = [(tuple(r[:4]), r[4]) for r in claim["boxes"]]
-        assert _separate_pieces(keys, rows) == 2
+        assert pieces_holding_sinks(keys, rows) == 2
         facts.append({"aspect_sign": 1 if claim["aspect"] == "WA1" else -1, "components_at_most": 2,
                       "components_at_least": 2})
     assert count_bound("aspects", facts) == count_upper("aspects", facts) == 4
@@ -213,7 +214,7 @@ def test_a_false_join_of_two_groups_of_sinks_is_refused(second_geometry, second_
     keys = {tuple(r[:4]) for r in claim["boxes"]}
     sinks = [tuple(r[:4]) for r in claim["boxes"] if r[4] == -2]
     deepest = max(r[0] for r in claim["boxes"])
-    assert _sink_groups(keys, sinks, deepest) == 1  # combinatorially joined
+    assert sink_groups(keys, sinks, deepest) == 1  # combinatorially joined
     assert "not proved inside WA1" in _refused(second_geometry, claim)
 
 
@@ -231,7 +232,7 @@ def test_a_false_separation_is_refused(paper_geometry, claims):
     rest = [r for r in claim["boxes"] if not (on_wall(r) and r[4] != -1)]
     claim["boxes"] = [r[:4] + [-1] for r in wall] + rest
     keys = {tuple(r[:4]) for r in claim["boxes"]}
-    assert _separate_pieces(keys, [(tuple(r[:4]), r[4]) for r in claim["boxes"]]) == 2
+    assert pieces_holding_sinks(keys, [(tuple(r[:4]), r[4]) for r in claim["boxes"]]) == 2
     assert "not proved free of WA1" in _refused(paper_geometry, claim)
 
 

@@ -44,6 +44,7 @@ from typing import Callable
 
 from flint import arb
 
+from intervalkin.checker.aspect_tiling import across, check_tiling, separate_pieces, sink_groups
 from intervalkin.checker.labels import holds_on_box
 from intervalkin.checker.model import ArbModel, balls, leg_sq
 from intervalkin.checker.parse import Refused, get, read_aspect, read_hex_box, read_int
@@ -220,69 +221,6 @@ def _read_rows(claim: dict):
     return e, w, out
 
 
-def _check_tiling(keys: set, deepest: int) -> None:
-    total = 0
-    for key in keys:
-        lev = key[0]
-        for up in range(1, lev + 1):
-            if (lev - up,) + tuple(c >> up for c in key[1:]) in keys:
-                raise Refused(f"box {list(key)} lies inside another box of the cover")
-        total += 8 ** (deepest - lev)
-    if total != 8 ** deepest:
-        raise Refused("the boxes do not tile the domain (their volumes do not add up to it)")
-
-
-def _across(keys: set, key, face: int, deepest: int):
-    """The boxes of the cover across ``face`` of box ``key`` (None: the x or y border of the domain)."""
-    lev, ax, step = key[0], face // 2, 1 if face % 2 else -1
-    c = list(key[1:])
-    c[ax] += step
-    if ax < 2 and not 0 <= c[ax] < (1 << lev):
-        return None
-    c[ax] %= 1 << lev
-    for up in range(lev + 1):
-        k = (lev - up,) + tuple(v >> up for v in c)
-        if k in keys:
-            return [k]
-    found, stack = [], [(lev, c)]
-    near = 0 if step > 0 else 1  # the children of the neighbour that touch the face
-    while stack:
-        lv, cc = stack.pop()
-        for o1 in (0, 1):
-            for o2 in (0, 1):
-                off = [o1, o2]
-                off.insert(ax, near)
-                k = (lv + 1,) + tuple(2 * v + o for v, o in zip(cc, off))
-                if k in keys:
-                    found.append(k)
-                elif lv + 1 < deepest:
-                    stack.append((lv + 1, list(k[1:])))
-                else:
-                    raise Refused(f"no box of the cover across face {face} of box {list(key)}")
-    return found
-
-
-def _sink_groups(keys: set, sinks: list, deepest: int) -> int:
-    """The number of face-connected groups of sink boxes (union-find; phi wraps)."""
-    parent = {k: k for k in sinks}
-
-    def root(k):
-        while parent[k] != k:
-            parent[k] = parent[parent[k]]
-            k = parent[k]
-        return k
-
-    for k in sinks:
-        for face in (1, 3, 5):
-            for nb in _across(keys, k, face, deepest) or []:
-                if nb in parent:
-                    parent[root(nb)] = root(k)
-    return len({root(k) for k in sinks})
-
-
-_AROUND = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)]
-
-
 def _check_cuts(model: ArbModel, domain, deepest: int) -> None:
     """What the pieces need of the domain: strictly increasing finest cuts, a strict phi excess."""
     for n, (lo, hi) in enumerate(domain):
@@ -297,35 +235,9 @@ def _check_cuts(model: ArbModel, domain, deepest: int) -> None:
         raise Refused("domain: for the pieces, the phi range must exceed 2 pi by less than its first and last slices")
 
 
-def _separate_pieces(keys: set, rows: list) -> int:
-    """The number of pieces (contact components of the non-OUT boxes; phi wraps) that hold a sink.
-
-    Two closed boxes of a tiling meet exactly when, for one of the 26 offsets d, the cell of the
-    finer one's level beside it along d lies in the coarser one: each box looks along every d for
-    the box holding that cell at its own level or above (the finer boxes beside it find it in turn).
-    """
-    keep = {key for key, code in rows if not _is_out(code)}
-    parent = {k: k for k in keep}
-
-    def root(k):
-        while parent[k] != k:
-            parent[k] = parent[parent[k]]
-            k = parent[k]
-        return k
-
-    for key in keep:
-        lev, n = key[0], 1 << key[0]
-        for d in _AROUND:
-            c = [key[1] + d[0], key[2] + d[1], (key[3] + d[2]) % n]
-            if not (0 <= c[0] < n and 0 <= c[1] < n):
-                continue
-            for up in range(lev + 1):
-                k = (lev - up, c[0] >> up, c[1] >> up, c[2] >> up)
-                if k in keys:
-                    if k in parent and k != key:
-                        parent[root(k)] = root(key)
-                    break
-    return len({root(k) for k, code in rows if code == _SINK})
+def pieces_holding_sinks(keys: set, rows: list) -> int:
+    """:func:`~intervalkin.checker.aspect_tiling.separate_pieces` over a claim's rows (key, code)."""
+    return separate_pieces(keys, {k for k, c in rows if not _is_out(c)}, [k for k, c in rows if c == _SINK])
 
 
 def _check_order(keys: set, rows: list, dirs: list, deepest: int) -> None:
@@ -338,7 +250,7 @@ def _check_order(keys: set, rows: list, dirs: list, deepest: int) -> None:
         for face, comp in ((0, a), (2, b), (4, c)):
             if comp == 0:
                 continue
-            nbs = _across(keys, key, face + (comp > 0), deepest)
+            nbs = across(keys, key, face + (comp > 0), deepest)
             if nbs is None:
                 raise Refused(f"box {list(key)}: an exit face lies on the x or y border of the domain")
             if any(nb not in resolved for nb in nbs):
@@ -360,17 +272,17 @@ def check_aspect_connected(model: ArbModel, claim: dict, prec: int) -> tuple[str
     if len(keys) != len(rows):
         raise Refused("boxes: a box is listed twice")
     _check_domain(model, domain, deepest)
-    _check_tiling(keys, deepest)
+    check_tiling(keys, deepest)
     sinks = [k for k, code in rows if code == _SINK]
     empty = all(_is_out(code) for _, code in rows)
-    groups = _sink_groups(keys, sinks, deepest)
+    groups = sink_groups(keys, sinks, deepest)
     pieces = 0
     if not empty:
         if not sinks:
             raise Refused("no sink box: the retractions have nowhere to end")
         _check_order(keys, rows, dirs, deepest)
         _check_cuts(model, domain, deepest)
-        pieces = _separate_pieces(keys, rows)
+        pieces = pieces_holding_sinks(keys, rows)
     evec = [(arb(a), arb(b), arb(c) / div) for a, b, c, div in dirs]
     for key, code in rows:
         box = _box(domain, key)

@@ -97,6 +97,16 @@ class JointSpacePaving:
             out[self.pieces.box] = known[pc[:, 0]] & known[pc[:, 1]]
         return out
 
+    def open_places(self) -> dict:
+        """What the paving leaves open (the ``undecided`` block of the counts it backs): the volume of undecided
+        leaves, the certified share, the fragments and the fold pieces joined to no cell."""
+        fs = self.fold_stats
+        return {"joint_volume": self.undecided_volume(), "joint_certified_share": self.certified_share(),
+                "fragments": [{"count": c.count, "volume": c.volume, "witness": [str(v) for v in c.witness]}
+                              for c in self.fragments],
+                "unjoined_fold_pieces": {"groups": int(fs.get("unjoined_piece_groups", 0)),
+                                         "volume": float(fs.get("unjoined_piece_volume", 0.0))}}
+
     def undecided_volume(self) -> float:
         """Volume of the leaves that are neither clear nor fold boxes with both pieces counted."""
         return float(self.paving.volume()[(self.cell < 0) & ~self.counted_fold_mask()].sum())
