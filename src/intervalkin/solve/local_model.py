@@ -25,7 +25,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.interval import PI_LO
+from intervalkin.core.interval import PI_LO, Interval
 from intervalkin.solve.fold_model import FoldModels, fold_models, pose_hulls
 
 __all__ = ["cluster_cells", "local_models", "MAX_GROUPED"]
@@ -113,7 +113,6 @@ def local_models(geometry: Geometry, joint_boxes: np.ndarray, owner: np.ndarray,
 
 
 def _empty(n: int) -> FoldModels:
-    from intervalkin.core.interval import Interval
     nan = np.full((n, 3, 2), np.nan)
     m33 = Interval(np.full((n, 3, 3), np.nan), np.full((n, 3, 3), np.nan))
     return FoldModels(np.zeros(n, dtype=bool), np.full(n, -1, dtype=np.int8), nan,

@@ -15,6 +15,12 @@ connected and lies off g(S), so one certified solve at an exact rational point o
 any of its boxes gives the count and split of the whole cell
 (proofs/lemma-clear-joint-box.md, proofs/lemma-constant-count-off-gS.md).
 
+Local models (:mod:`intervalkin.space.joint_models`, on by default): each undecided
+leaf is proved clear by Krawczyk exclusion, or cut by one proved fold sheet into two
+pieces that join the cells, or left unresolved; unresolved leaves are split
+``model_levels`` more times.  Components made only by that local refinement, touching
+no face of the joint box, are *fragments*: listed, not counted as cells.
+
 Joins: an undecided box that touches two cells with the same count and split may
 be a wall of the paving, not of g(S).  Such boxes are refined past ``depth`` (up to
 ``join_levels`` more levels, only there); clear sub-boxes that touch both cells
@@ -22,8 +28,8 @@ join them, by the same face-adjacency argument.
 
 What is NOT claimed: two cells are not proved to be different components of the
 joint box minus g(S) (they may still join through undecided boxes), and undecided
-boxes may hide small cells.  Counting cells exactly is the subject of the
-certified local models (DESIGN.md section 8).
+boxes may hide small cells.  Counting cells exactly needs a model for every
+undecided box (cusps and crossings of g(S) have none yet; DESIGN.md section 8).
 """
 
 from __future__ import annotations
