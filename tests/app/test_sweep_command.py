@@ -104,15 +104,19 @@ def test_an_interrupted_sweep_restarts_where_it_stopped(tmp_path, capsys):
     out = tmp_path / "out"
     args = ["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "--no-dashboard", "--quiet"]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    # the child must see SIGINT as a user's Ctrl-C would: an ignored SIGINT is inherited across exec, and a
+    # library that ran earlier in this test process (Dask's nannies, process pools) may have left it ignored
     run = subprocess.Popen([sys.executable, "-m", "intervalkin.app.cli", *args], env=env,
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and run.poll() is None and len(list((out / "designs").glob("*.json"))) < 2:
         time.sleep(0.05)
     run.send_signal(signal.SIGINT)
     _, err = run.communicate(timeout=60)
     done = len(list((out / "designs").glob("*.json")))
-    assert run.returncode == 130 and "interrupted" in err and 2 <= done < 10, (run.returncode, err, done)
+    assert run.returncode == 130 and "interrupted" in err and 2 <= done < 10, (run.returncode, err, done,
+                                                                                 signal.getsignal(signal.SIGINT))
     assert not json.loads((out / MARKER).read_text())["complete"]
     assert not list(out.rglob(".*.tmp"))  # nothing half-written
 
