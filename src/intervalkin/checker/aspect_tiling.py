@@ -54,22 +54,39 @@ def across(keys: set, key, face: int, deepest: int):
     return found
 
 
-def sink_groups(keys: set, sinks: list, deepest: int) -> int:
-    """The number of face-connected groups of sink boxes (union-find; phi wraps)."""
-    parent = {k: k for k in sinks}
+class _Groups:
+    """Union-find over box keys (path halving)."""
 
-    def root(k):
+    def __init__(self, keys):
+        self.parent = {k: k for k in keys}
+
+    def __contains__(self, k) -> bool:
+        return k in self.parent
+
+    def root(self, k):
+        parent = self.parent
         while parent[k] != k:
             parent[k] = parent[parent[k]]
             k = parent[k]
         return k
 
+    def join(self, a, b) -> None:
+        self.parent[self.root(a)] = self.root(b)
+
+    def count(self, keys) -> int:
+        """The number of groups the given keys fall in."""
+        return len({self.root(k) for k in keys})
+
+
+def sink_groups(keys: set, sinks: list, deepest: int) -> int:
+    """The number of face-connected groups of sink boxes (union-find; phi wraps)."""
+    groups = _Groups(sinks)
     for k in sinks:
         for face in (1, 3, 5):
             for nb in across(keys, k, face, deepest) or []:
-                if nb in parent:
-                    parent[root(nb)] = root(k)
-    return len({root(k) for k in sinks})
+                if nb in groups:
+                    groups.join(nb, k)
+    return groups.count(sinks)
 
 
 AROUND = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)]
@@ -82,14 +99,7 @@ def separate_pieces(keys: set, keep: set, sinks: list) -> int:
     finer one's level beside it along d lies in the coarser one: each box looks along every d for
     the box holding that cell at its own level or above (the finer boxes beside it find it in turn).
     """
-    parent = {k: k for k in keep}
-
-    def root(k):
-        while parent[k] != k:
-            parent[k] = parent[parent[k]]
-            k = parent[k]
-        return k
-
+    groups = _Groups(keep)
     for key in keep:
         lev, n = key[0], 1 << key[0]
         for d in AROUND:
@@ -99,7 +109,7 @@ def separate_pieces(keys: set, keep: set, sinks: list) -> int:
             for up in range(lev + 1):
                 k = (lev - up, c[0] >> up, c[1] >> up, c[2] >> up)
                 if k in keys:
-                    if k in parent and k != key:
-                        parent[root(k)] = root(key)
+                    if k in groups and k != key:
+                        groups.join(k, key)
                     break
-    return len({root(k) for k in sinks})
+    return groups.count(sinks)
