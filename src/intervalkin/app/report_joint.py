@@ -37,9 +37,9 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
            f"graph and both of its pieces are counted ({jc['fold_boxes']} fold boxes). Certified: "
            f"{100 * jc['certified_share']:.1f}% of the joint box; undecided volume {jc['undecided_volume']:.1f}.\n",
            "A cell is a connected set of certified boxes and pieces; one complete certified solve at its witness "
-           "gives its count and aspect split, which hold at every point of the cell. Above a cell with n "
-           "solutions lie n basic regions, n/2 in each aspect (Theorem 1 and Proposition 1), so the count of "
-           "basic regions is the sum of the cells' counts:\n",
+           "gives its count and aspect split, which hold at every point of the cell. Above a cell whose points have "
+           "n_1 solutions in WA1 and n_2 in WA2 lie n_1 basic regions in WA1 and n_2 in WA2 (Theorem 1 and "
+           "Proposition 1), so the count of basic regions is the sum of the cells' counts:\n",
            "| cell | solutions | WA1 | WA2 | volume | witness (rho_1, rho_2, rho_3) | where |",
            "|---|---|---|---|---|---|---|"]
     for c in jc["cells"]:
@@ -57,7 +57,7 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
                "minus g(S), and undecided boxes could still join two of them or hide a small one.\n")
     frags = jc.get("fragments") or []
     if frags:
-        out.append(f"{len(frags)} fragments (certified islands inside the undecided layer, made only by the local "
+        out.append(f"{len(frags)} fragment{'' if len(frags) == 1 else 's'} (certified islands inside the undecided layer, made only by the local "
                    "refinement and joined to no cell; each lies in some component, perhaps one of the cells "
                    "above) are listed apart and not counted: "
                    + ", ".join(f"{f['count']} solutions at ({', '.join(f'{float(Fraction(v)):.2f}' for v in f['witness'])})"
