@@ -13,26 +13,18 @@ import numpy as np
 from flint import arb, ctx
 
 from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_interval
-from intervalkin.kinematics.formulas import approx_det_a, det_a_arb, rho_sq_arb
+from intervalkin.kinematics.formulas import det_a_arb, rho_sq_arb
 from intervalkin.kinematics.point_enclosures import rho_sq_det_at
+from tests.solve.shared import det_zeros_along_y
 
 
 def _poses(geometry, rng, n):
     P = np.c_[rng.uniform(-15, 35, n), rng.uniform(-15, 35, n), rng.uniform(-np.pi, np.pi, n)]
-    # half of them moved onto det A = 0 along y (bisection in float): the hardest place for the sign
-    for row in P[: n // 2]:
-        ys = np.linspace(-15, 35, 201)
-        det = approx_det_a(geometry, np.c_[np.full(201, row[0]), ys, np.full(201, row[2])])
-        ch = np.flatnonzero(np.sign(det[:-1]) != np.sign(det[1:]))
-        if ch.size:
-            a, b = ys[ch[0]], ys[ch[0] + 1]
-            for _ in range(60):
-                m = 0.5 * (a + b)
-                if np.sign(approx_det_a(geometry, np.array([[row[0], m, row[2]]]))[0]) == np.sign(det[ch[0]]):
-                    a = m
-                else:
-                    b = m
-            row[1] = a
+    # half of them moved onto det A = 0 along y (the first sign change of each line): the hardest place
+    half = P[: n // 2]
+    line, a, _ = det_zeros_along_y(geometry, half[:, 0], half[:, 2], np.linspace(-15, 35, 201))
+    first = np.r_[True, line[1:] != line[:-1]]
+    half[line[first], 1] = a[first]
     return P
 
 

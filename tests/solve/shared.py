@@ -49,3 +49,26 @@ def concurrent_legs_box(width: float) -> np.ndarray:
     box = np.stack([q - width, q + width], axis=-1)[None]
     box[0, 2, 0] = 10.0
     return box
+
+
+def det_zeros_along_y(geometry, x: np.ndarray, phi: np.ndarray, ys: np.ndarray):
+    """Every sign change of det A (float) along y on the lines (x_l, ., phi_l), bisected 60 times.
+
+    Returns (line, a, b): the line of each change and its bracket, a on the side of the
+    smaller sample (its sign), b across; b - a is then about one ulp.  Not certified: it
+    makes test inputs on det A = 0, where enclosures and labels are hardest.
+    """
+    from intervalkin.kinematics.formulas import approx_det_a
+
+    x, phi = np.asarray(x, dtype=float), np.asarray(phi, dtype=float)
+    grid = np.stack(np.broadcast_arrays(x[:, None], ys[None, :], phi[:, None]), axis=-1)
+    det = approx_det_a(geometry, grid.reshape(-1, 3)).reshape(len(x), len(ys))
+    line, c = np.nonzero(np.sign(det[:, :-1]) * np.sign(det[:, 1:]) < 0)
+    a, b, da = ys[c], ys[c + 1], det[line, c]
+    for _ in range(60):
+        m = 0.5 * (a + b)
+        dm = approx_det_a(geometry, np.stack([x[line], m, phi[line]], axis=1))
+        same = np.sign(dm) == np.sign(da)
+        a, b, da = np.where(same, m, a), np.where(same, b, m), np.where(same, dm, da)
+    return line, a, b
+

@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 
 from intervalkin.core.interval import PI_HI
-from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
+from intervalkin.kinematics.formulas import approx_inverse_kinematics
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.local_model import cluster_cells
 from intervalkin.space.joint_paving import pave_joint_space
-from tests.solve.shared import split_of
+from tests.solve.shared import det_zeros_along_y, split_of
 
 
 @pytest.fixture(scope="module")
@@ -34,16 +34,7 @@ def _singular_joint_vectors(geometry, rng, n_lines):
     """Joint vectors of poses within 1e-12 of det A = 0: sign changes of det A along y, bisected."""
     x = rng.uniform(-15, 35, n_lines)
     phi = rng.uniform(-np.pi, np.pi, n_lines)
-    ys = np.linspace(-15, 35, 401)
-    grid = np.stack(np.broadcast_arrays(x[:, None], ys[None, :], phi[:, None]), axis=-1)
-    det = approx_det_a(geometry, grid.reshape(-1, 3)).reshape(n_lines, len(ys))
-    line, c = np.nonzero(np.sign(det[:, :-1]) * np.sign(det[:, 1:]) < 0)
-    a, b, da = ys[c], ys[c + 1], det[line, c]
-    for _ in range(60):
-        m = 0.5 * (a + b)
-        dm = approx_det_a(geometry, np.stack([x[line], m, phi[line]], axis=1))
-        same = np.sign(dm) == np.sign(da)
-        a, b, da = np.where(same, m, a), np.where(same, b, m), np.where(same, dm, da)
+    line, a, b = det_zeros_along_y(geometry, x, phi, np.linspace(-15, 35, 401))
     return approx_inverse_kinematics(geometry, np.stack([x[line], 0.5 * (a + b), phi[line]], axis=1))
 
 
