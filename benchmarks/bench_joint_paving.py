@@ -37,18 +37,17 @@ def _agreement(geometry, jp, samples: int, seed: int) -> tuple[int, int, int, in
     dom = joint_domain(geometry)
     rng = np.random.default_rng(seed)
     q = dom[:, 0] + rng.random((samples, 3)) * (dom[:, 1] - dom[:, 0])
-    cell = jp.cell_of(q, geometry)
-    by_id = {c.id: c for c in jp.cells + jp.fragments}
+    sig = jp.signature_of(q, geometry)
     labelled = agree = wrong = 0
-    for v, cid in zip(q, cell):
-        if cid < 0:
+    for v, label in zip(q, sig):
+        if label[0] < 0:
             continue
         labelled += 1
         res = solve(geometry, [Fraction(float(x)) for x in v])
         if not res.complete:
             continue
         n1 = sum(1 for s in res.solutions if s.aspect == "WA1")
-        if (res.count, n1, res.count - n1) == by_id[int(cid)].signature:
+        if (res.count, n1, res.count - n1) == tuple(int(x) for x in label):
             agree += 1
         else:
             wrong += 1

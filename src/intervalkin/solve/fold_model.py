@@ -53,7 +53,7 @@ from intervalkin.kinematics.enclosures import (det_a_gradient_interval, jacobian
                                                rho_sq_leg_interval)
 from intervalkin.kinematics.point_enclosures import rho_sq_det_at
 
-__all__ = ["FoldModels", "fold_models", "side_of", "pose_hulls"]
+__all__ = ["FoldModels", "fold_models", "side_of", "pose_hulls", "krawczyk_image", "normal_signs", "preconditioned", "SIDE_STEPS"]
 
 #: Krawczyk rounds before a box is given up: the first shrink the pose box to its intersection with
 #: the images, the last INFLATE_ROUNDS grow it to the hull of the box and the images (plus a margin).
@@ -161,7 +161,7 @@ def _residual(values: tuple[Interval, Interval], k: int, P: Interval) -> Interva
     return Interval(np.stack([ri.lo, rj.lo, d.lo], 1), np.stack([ri.hi, rj.hi, d.hi], 1))
 
 
-def _preconditioned(grads: tuple[Interval, Interval], k: int) -> tuple[np.ndarray, Interval]:
+def preconditioned(grads: tuple[Interval, Interval], k: int) -> tuple[np.ndarray, Interval]:
     """(Y, C): Y = mid(E'(X))^-1 (NaN where singular) and C = I - Y E'(X) (interval), from the gradients over X."""
     A, G = grads
     i, j = [a for a in range(3) if a != k]
@@ -182,7 +182,7 @@ def _preconditioned(grads: tuple[Interval, Interval], k: int) -> tuple[np.ndarra
     return Y, Interval(C_lo, C_hi)
 
 
-def _krawczyk(geometry: Geometry, X: np.ndarray, k: int, P: Interval, Y: np.ndarray, C: Interval,
+def krawczyk_image(geometry: Geometry, X: np.ndarray, k: int, P: Interval, Y: np.ndarray, C: Interval,
               values: tuple[Interval, Interval] | None = None) -> np.ndarray:
     """The Krawczyk image (n, 3, 2) of pose boxes X for parameters P, with Y and C = I - Y E'(X') for X' containing X.
 
@@ -214,7 +214,7 @@ def _cross(ax, ay, bx, by):
     return ax * by - ay * bx
 
 
-def _normal_signs(geometry: Geometry, K: np.ndarray) -> np.ndarray:
+def normal_signs(geometry: Geometry, K: np.ndarray) -> np.ndarray:
     """(n, 3) int8: certified signs of w_l = u_m x u_n over the pose boxes (0: not proved)."""
     A = jacobian_interval(geometry, K)  # row l is 2 (u_lx, u_ly, r_l x u_l)
     u = [(A[:, l, 0], A[:, l, 1]) for l in range(3)]
@@ -266,8 +266,8 @@ def fold_models(geometry: Geometry, joint_boxes: np.ndarray, hulls: np.ndarray, 
                 rows = idx[live]
                 P = Interval(np.stack([rho.lo[rows, i], rho.lo[rows, j]], 1),
                              np.stack([rho.hi[rows, i], rho.hi[rows, j]], 1))
-                Y, C = _preconditioned(grads, k)
-                K = _krawczyk(geometry, Xl, k, P, Y, C, vals)
+                Y, C = preconditioned(grads, k)
+                K = krawczyk_image(geometry, Xl, k, P, Y, C, vals)
                 fin = np.isfinite(K).all(axis=(1, 2))
                 shrunk[fin, :, 0] = np.maximum(shrunk[fin, :, 0], K[fin, :, 0])
                 shrunk[fin, :, 1] = np.minimum(shrunk[fin, :, 1], K[fin, :, 1])
@@ -315,7 +315,7 @@ def _connected(geometry: Geometry, K: np.ndarray, X: np.ndarray, k: int, R: Inte
     i, j = [a for a in range(3) if a != k]
     hk = rho_sq_interval(geometry, K)[:, k].sqrt()
     inside_k = (hk.lo > R.lo[:, k]) & (hk.hi < R.hi[:, k])
-    sg = _normal_signs(geometry, K)
+    sg = normal_signs(geometry, K)
     good = inside_k | ((sg[:, i] != 0) & (sg[:, j] != 0) & (sg[:, k] != 0))
     for a, b in ((0, 1), (1, 0)):  # monotone along parameter b, both end edges checked along a
         cand = np.flatnonzero(~good & (sg[:, k] != 0) & (sg[:, (i, j)[b]] != 0))
@@ -342,7 +342,7 @@ def _height(geometry: Geometry, X: np.ndarray, k: int, P: Interval, Y: np.ndarra
     intersection of the images holds it; NaN bounds where a step failed (no claim).
     """
     for _ in range(SIDE_STEPS):
-        K = _krawczyk(geometry, X, k, P, Y, C)
+        K = krawczyk_image(geometry, X, k, P, Y, C)
         fin = np.isfinite(K).all(axis=(1, 2))
         K = np.where(fin[:, None, None], K, np.stack([np.full(X.shape[:2], np.nan)] * 2, axis=-1))
         X = np.stack([np.fmax(X[:, :, 0], K[:, :, 0]), np.fmin(X[:, :, 1], K[:, :, 1])], axis=-1)
@@ -376,7 +376,7 @@ def side_of(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.
         todo = np.arange(sel.size)
         for _ in range(SIDE_STEPS):  # most points are placed after one step: stop there
             t = todo
-            K = _krawczyk(geometry, X[t], k, P[t], models.inv[rows[t]], models.contraction[rows[t]])
+            K = krawczyk_image(geometry, X[t], k, P[t], models.inv[rows[t]], models.contraction[rows[t]])
             fin = np.isfinite(K).all(axis=(1, 2))
             K = np.where(fin[:, None, None], K, X[t])
             Xt = np.stack([np.maximum(X[t, :, 0], K[:, :, 0]), np.minimum(X[t, :, 1], K[:, :, 1])], axis=-1)

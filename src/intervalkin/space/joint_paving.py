@@ -22,9 +22,14 @@ pieces that join the cells, or left unresolved; unresolved leaves are split
 no face of the joint box, are *fragments*: listed, not counted as cells.
 
 Joins: an undecided box that touches two cells with the same count and split may
-be a wall of the paving, not of g(S).  Such boxes are refined past ``depth`` (up to
-``join_levels`` more levels, only there); clear sub-boxes that touch both cells
-join them, by the same face-adjacency argument.
+be a wall of the paving, not of g(S).  Such boxes are refined past the finest level
+of the local refinement (up to ``join_levels`` more levels, only there); clear
+sub-boxes that touch both cells join them, by the same face-adjacency argument.
+
+Pieces joined to no cell still get a certified signature when the other piece of
+their box has one: the side of the sheet on which the two extra solutions live is
+proved at one sheet point (:mod:`intervalkin.solve.fold_side`), and a piece can be
+proved empty.  A fold box counts as certified volume when each piece is known or empty.
 
 What is NOT claimed: two cells are not proved to be different components of the
 joint box minus g(S) (they may still join through undecided boxes), and undecided
@@ -44,13 +49,12 @@ from intervalkin.core.errors import InputError
 from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.geometry import Geometry
 from intervalkin.paving.budget import check_depth
-from intervalkin.paving.labels import Label
-from intervalkin.paving.tree import Paving, box_bounds, split_boxes
+from intervalkin.paving.tree import Paving
 from intervalkin.solve.fold_model import side_of
-from intervalkin.solve.joint_box import initial_cells, live_cells
+from intervalkin.space.joint_leaves import adaptive_leaves, leaves_to_paving, refine_leaves
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
 from intervalkin.space.joint_models import ModelStore
-from intervalkin.space.joint_pieces import FoldPieces
+from intervalkin.space.joint_pieces import FoldPieces, PieceSignatures, piece_signatures
 
 __all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain", "DEFAULT_JOINT_DEPTH", "JOIN_LEVELS", "MODEL_LEVELS"]
 
@@ -82,6 +86,8 @@ class JointSpacePaving:
         of g(S)); each has a certified count and lies in some component of the joint box minus
         g(S), but it is not joined to one, so it is listed apart and not counted as a cell.  Their
         ids follow the cells' ids.
+    piece_signatures : the certified signature of each fold piece, from its cell or inferred from
+        the other piece of its box (:func:`intervalkin.space.joint_pieces.piece_signatures`).
     """
 
     paving: Paving
@@ -92,15 +98,13 @@ class JointSpacePaving:
     fold_stats: dict = field(default_factory=dict)
     voided: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     fragments: tuple[JointSpaceCell, ...] = ()
+    piece_signatures: PieceSignatures | None = None
 
     def counted_fold_mask(self) -> np.ndarray:
-        """(n,) bool: the leaves that are fold boxes whose two pieces both lie in cells of known count."""
+        """(n,) bool: the leaves that are fold boxes each of whose pieces has a certified signature or is empty."""
         out = np.zeros(len(self.cell), dtype=bool)
-        if self.pieces is not None and len(self.pieces):
-            every = sorted(self.cells + self.fragments, key=lambda c: c.id)
-            known = np.array([c.count >= 0 for c in every] + [False], dtype=bool)
-            pc = self.piece_cell.reshape(-1, 2)
-            out[self.pieces.box] = known[pc[:, 0]] & known[pc[:, 1]]
+        if self.pieces is not None and len(self.pieces) and self.piece_signatures is not None:
+            out[self.pieces.box] = self.piece_signatures.counted()
         return out
 
     def open_places(self) -> dict:
@@ -145,112 +149,60 @@ class JointSpacePaving:
             out[at] = np.where(side != 0, pc, -1)
         return out
 
+    def signature_of(self, rho: np.ndarray, geometry: Geometry) -> np.ndarray:
+        """(m, 3) certified (count, n_wa1, n_wa2) at joint vectors rho (m, 3), -1 where not known.
+
+        A vector in a clear leaf takes its cell's signature; one in a fold box is placed in a
+        piece by the side test and takes that piece's signature (from its cell, or inferred).
+        """
+        q = np.asarray(rho, dtype=np.float64)
+        out = np.full((len(q), 3), -1, dtype=np.int64)
+        every = {c.id: c.signature for c in self.cells + self.fragments}
+        cid = self.cell_of(q, geometry)
+        for i in np.flatnonzero(cid >= 0):
+            out[i] = every[int(cid[i])]
+        if self.pieces is None or not len(self.pieces) or self.piece_signatures is None:
+            return out
+        leaf = self.paving.locate_boxes(np.stack([q, q], axis=-1))
+        row = np.full(len(self.cell), -1, dtype=np.int64)
+        row[self.pieces.box] = np.arange(len(self.pieces))
+        t = np.where(leaf >= 0, row[np.maximum(leaf, 0)], -1)
+        at = np.flatnonzero((out[:, 0] < 0) & (t >= 0))
+        if at.size:
+            side = side_of(geometry, self.pieces.models, t[at], q[at])
+            sig = self.piece_signatures.signature[t[at], (side > 0).astype(np.int64)]
+            out[at] = np.where((side != 0)[:, None], sig, -1)
+        return out
+
     def columns(self) -> dict[str, np.ndarray]:
         """npz columns: lo, hi, level, cell id, count, n_wa1, n_wa2 (-1 where undecided); and for fold
         boxes: fold_axis (the axis k of the sheet, -1 elsewhere), cell_below and cell_above (the cells of
-        the pieces q_k < h and q_k > h, -1 elsewhere or unknown)."""
+        the pieces q_k < h and q_k > h, -1 elsewhere or unknown), count_below and count_above (their
+        certified counts, inferred where the piece has no cell; -1 where unknown)."""
         count = np.full(len(self.cell), -1, dtype=np.int32)
         wa1, wa2 = count.copy(), count.copy()
         for c in self.cells + self.fragments:
             m = self.cell == c.id
             count[m], wa1[m], wa2[m] = c.count, c.n_wa1, c.n_wa2
         axis, below, above = count.copy(), count.copy(), count.copy()
+        n_below, n_above = count.copy(), count.copy()
         if self.pieces is not None and len(self.pieces):
             pc = self.piece_cell.reshape(-1, 2)
             axis[self.pieces.box] = self.pieces.models.axis
             below[self.pieces.box], above[self.pieces.box] = pc[:, 0], pc[:, 1]
+            if self.piece_signatures is not None:
+                n_below[self.pieces.box] = self.piece_signatures.signature[:, 0, 0]
+                n_above[self.pieces.box] = self.piece_signatures.signature[:, 1, 0]
         return {"lo": self.paving.lo, "hi": self.paving.hi, "level": self.paving.level.astype(np.int32),
                 "cell": self.cell.astype(np.int32), "count": count, "n_wa1": wa1, "n_wa2": wa2,
-                "fold_axis": axis, "cell_below": below, "cell_above": above}
+                "fold_axis": axis, "cell_below": below, "cell_above": above,
+                "count_below": n_below, "count_above": n_above}
 
 
 def joint_domain(geometry: Geometry) -> np.ndarray:
     """The joint box, rounded outward to floats: (3, 2) [rho_min_i, rho_max_i]."""
     return np.array([[fraction_bounds(lo)[0], fraction_bounds(hi)[1]]
                      for lo, hi in zip(geometry.rho_min, geometry.rho_max)], dtype=np.float64)
-
-
-@dataclass
-class _Front:
-    """Boxes waiting for their test, with the torus cells their parent left live (owner = row)."""
-
-    level: np.ndarray
-    ijk: np.ndarray
-    owner: np.ndarray
-    cells: np.ndarray
-
-
-def _children(front: _Front, cut: np.ndarray) -> _Front:
-    """The 8 children of the cut boxes of a tested front; each inherits its parent's live cells."""
-    rank = np.cumsum(cut) - 1
-    sel = cut[front.owner]
-    c = rank[front.owner[sel]]
-    child = (8 * c[:, None] + np.arange(8)[None, :]).ravel()
-    order = np.argsort(child, kind="stable")
-    level, ijk = split_boxes(front.level[cut], front.ijk[cut])
-    return _Front(level, ijk, child[order], np.repeat(front.cells[sel], 8, axis=0)[order])
-
-
-def _test(geometry: Geometry, domain: np.ndarray, front: _Front) -> tuple[np.ndarray, np.ndarray, np.ndarray, _Front]:
-    """Test a front: (lo, hi, clear mask, the front with its cells updated)."""
-    lo, hi = box_bounds(domain, front.level, front.ijk)
-    owner, cells = live_cells(geometry, np.stack([lo, hi], axis=-1), front.owner, front.cells)
-    clear = np.bincount(owner, minlength=len(front.level)) == 0
-    return lo, hi, clear, _Front(front.level, front.ijk, owner, cells)
-
-
-@dataclass
-class _Leaves:
-    """The leaves found so far; the undecided ones keep their live cells for later refinement."""
-
-    parts: list = field(default_factory=list)
-
-    def add(self, front: _Front, lo, hi, clear, keep) -> None:
-        idx = np.flatnonzero(keep)
-        pos = np.full(len(keep), -1)
-        pos[idx] = np.arange(idx.size)
-        sel = keep[front.owner]
-        self.parts.append((front.level[keep], front.ijk[keep], lo[keep], hi[keep], clear[keep],
-                           pos[front.owner[sel]], front.cells[sel]))
-
-    def merge(self) -> tuple[np.ndarray, ...]:
-        offs = np.cumsum([0] + [len(p[0]) for p in self.parts])
-        cols = [np.concatenate([p[i] for p in self.parts]) for i in range(5)]
-        owner = np.concatenate([p[5] + o for p, o in zip(self.parts, offs)])
-        cells = np.concatenate([p[6] for p in self.parts])
-        return (*cols, owner, cells)
-
-
-def _adaptive(geometry: Geometry, domain: np.ndarray, depth: int,
-              progress: Callable[[dict], None] | None) -> tuple[_Leaves, list[dict]]:
-    """Bisect the joint box, keeping clear boxes and splitting the others, down to ``depth``."""
-    owner, cells = initial_cells(1)
-    front = _Front(np.zeros(1, dtype=np.int64), np.zeros((1, 3), dtype=np.int64), owner, cells)
-    leaves = _Leaves()
-    stats: list[dict] = []
-    dom_vol = float(np.prod(domain[:, 1] - domain[:, 0]))
-    for lev in range(depth + 1):
-        t0 = time.perf_counter()
-        lo, hi, clear, front = _test(geometry, domain, front)
-        cut = ~clear if lev < depth else np.zeros(len(clear), dtype=bool)
-        leaves.add(front, lo, hi, clear, ~cut)
-        stats.append({"stage": "joint paving", "level": lev, "depth": depth, "boxes": int(len(clear)),
-                      "split": int(np.count_nonzero(cut)), "live_cells": int(front.owner.size),
-                      "seconds": time.perf_counter() - t0,
-                      "undecided_volume": {"clear": dom_vol * 8.0 ** (-lev) * int(np.count_nonzero(~clear))}})
-        if progress is not None:
-            progress(stats[-1])
-        if not np.any(cut):
-            break
-        front = _children(front, cut)
-    return leaves, stats
-
-
-def _to_paving(domain: np.ndarray, leaves: tuple[np.ndarray, ...], stats: list[dict]) -> Paving:
-    level, ijk, lo, hi, clear = leaves[:5]
-    lab = np.where(clear, Label.INSIDE, Label.BOUNDARY).astype(np.uint8)
-    return Paving(domain=domain, depth=int(level.max()), level=level.astype(np.int8), ijk=ijk, lo=lo, hi=hi,
-                  labels={"clear": lab}, stats=stats)
 
 
 def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_levels: int = JOIN_LEVELS,
@@ -262,13 +214,13 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     ----------
     depth : levels of uniform refinement of the undecided boxes (leaf width: the joint
         range / 2**depth); 1..11, memory checked before any work.
-    join_levels : further levels, only in undecided boxes that separate two cells of
-        equal count and split (0: no joins).
+    join_levels : further levels (past the finest level of the local refinement), only in
+        undecided boxes that separate two cells of equal count and split (0: no joins).
     fold : give the undecided leaves local models (:mod:`intervalkin.solve.local_model`):
         leaves proved free of singular poses by Krawczyk exclusion become clear, leaves cut
         by one proved fold sheet get two pieces that join the cells and count as certified
-        volume.  On the paper's manipulator at depth 6 with one model level: 96 % of the joint
-        box certified (76 % without models), in about 45 s (6 s without).
+        volume.  On the paper's manipulator at depth 6: 97 % of the joint box certified with
+        one model level, 99.3 % with two (76 % without models).
     face_levels : further levels in the undecided leaves that touch a face of the joint box.
     model_levels : with ``fold``, further levels in the leaves left without a model (split,
         re-tested, modelled again), the last step of the local refinement.
@@ -281,7 +233,7 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 8:
             raise InputError(f"{name}: expected an integer in 0..8, got {v!r}")
     domain = joint_domain(geometry)
-    found_leaves, stats = _adaptive(geometry, domain, depth, progress)
+    found_leaves, stats = adaptive_leaves(geometry, domain, depth, progress)
     leaves = found_leaves.merge()
     store = ModelStore(geometry) if fold else None
     settle = (lambda lv: store.settle(lv)) if store is not None else (lambda lv: lv)
@@ -291,7 +243,7 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         if not np.any(wall):
             break
         leaves = _timed(progress, stats, store, "local refinement", depth + extra + 1,
-                        lambda: settle(_refine(geometry, domain, leaves, wall)), leaves, wall)
+                        lambda: settle(refine_leaves(geometry, domain, leaves, wall)), leaves, wall)
     for extra in range(face_levels):
         # thin cells hug the faces rho_i = rho_min / rho_max: refine the undecided leaves that touch one
         level, lo, hi, clear = leaves[0], leaves[2], leaves[3], leaves[4]
@@ -300,8 +252,8 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         if not np.any(wall):
             break
         leaves = _timed(progress, stats, store, "faces", depth + extra + 1,
-                        lambda: settle(_refine(geometry, domain, leaves, wall)), leaves, wall)
-    fine = int(leaves[0].max())
+                        lambda: settle(refine_leaves(geometry, domain, leaves, wall)), leaves, wall)
+    fine = top = int(leaves[0].max())
     cells = CellSolver(geometry)
 
     def anchor(lv):  # boxes of the uniform paving and of the face refinement may start a cell
@@ -309,32 +261,40 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         return (lv[0] <= depth) | touch
 
     for extra in range(join_levels + 1):
-        paving = _to_paving(domain, leaves, stats)
+        paving = leaves_to_paving(domain, leaves, stats)
         cell, found, _, _ = cells.label(paving, fine, anchor=anchor(leaves))
         if extra == join_levels:
             break
-        wall = joining_paths(cells.edges, cell, found) & (paving.level < depth + join_levels)
+        # walls as fine as the local refinement made them may still be split join_levels times
+        wall = joining_paths(cells.edges, cell, found) & (paving.level < top + join_levels)
         if not np.any(wall):
             break
         leaves = _timed(progress, stats, store, "joins", depth + extra + 1,
-                        lambda: settle(_refine(geometry, domain, leaves, wall)), leaves, wall)
+                        lambda: settle(refine_leaves(geometry, domain, leaves, wall)), leaves, wall)
         fine = max(fine, int(leaves[0].max()))
-    pieces, piece_cell, fold_stats = None, np.zeros(0, dtype=np.int32), {}
+    pieces, piece_cell, fold_stats, signatures = None, np.zeros(0, dtype=np.int32), {}, None
     if store is not None:
         t0 = time.perf_counter()
-        paving = _to_paving(domain, leaves, stats)
+        paving = leaves_to_paving(domain, leaves, stats)
         cell, found, pieces, piece_cell = cells.label(paving, fine, lambda e: store.pieces(leaves, e),
                                                       anchor(leaves))
         unjoined = cells.unjoined
+        signatures = None
+        if pieces is not None:
+            every = {c.id: c.signature for c in found}
+            from_cells = np.array([every.get(int(c), (-1, -1, -1)) for c in piece_cell], dtype=np.int64)
+            signatures = piece_signatures(geometry, paving.lo, paving.hi, pieces, from_cells.reshape(-1, 3))
         fold_stats = {"fold_boxes": 0 if pieces is None else len(pieces), "seconds": time.perf_counter() - t0,
                       "void_boxes": int(store.void_keys.size), "void_volume": store.void_volume,
-                      "unjoined_piece_groups": unjoined[0], "unjoined_piece_volume": unjoined[1]}
+                      "unjoined_piece_groups": unjoined[0], "unjoined_piece_volume": unjoined[1],
+                      "inferred_piece_signatures": 0 if signatures is None else signatures.inferred,
+                      "empty_pieces": 0 if signatures is None else int(np.count_nonzero(signatures.empty))}
         if progress is not None:
             progress({"stage": "fold pieces", "level": fine, "depth": fine,
                       "boxes": fold_stats["fold_boxes"], "split": 0, "cells": len(found)})
     voided = store.voided(paving.level, paving.ijk) if store is not None else np.zeros(len(cell), dtype=bool)
     return JointSpacePaving(paving, cell, tuple(c for c in found if not c.fragment), pieces, piece_cell,
-                            fold_stats, voided, tuple(c for c in found if c.fragment))
+                            fold_stats, voided, tuple(c for c in found if c.fragment), signatures)
 
 
 def _timed(progress, stats: list, store, stage: str, level: int, step: Callable, leaves, wall=None):
@@ -356,20 +316,3 @@ def _timed(progress, stats: list, store, stage: str, level: int, step: Callable,
     if progress is not None:
         progress(st)
     return out
-
-
-def _refine(geometry: Geometry, domain: np.ndarray, leaves: tuple[np.ndarray, ...], wall: np.ndarray):
-    """Split the wall leaves once and test their children (inheriting the walls' live cells)."""
-    level, ijk, lo, hi, clear, owner, cells = leaves
-    sel = wall[owner]
-    rank = np.cumsum(wall) - 1
-    front = _Front(level[wall], ijk[wall], rank[owner[sel]], cells[sel])
-    front = _children(front, np.ones(len(front.level), dtype=bool))
-    clo, chi, cclear, front = _test(geometry, domain, front)
-    out = _Leaves()
-    keep = ~wall
-    pos = np.full(len(keep), -1)
-    pos[keep] = np.arange(np.count_nonzero(keep))
-    out.parts.append((level[keep], ijk[keep], lo[keep], hi[keep], clear[keep], pos[owner[~sel]], cells[~sel]))
-    out.add(front, clo, chi, cclear, np.ones(len(cclear), dtype=bool))
-    return out.merge()

@@ -25,9 +25,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.solve.fold_model import FoldModels, side_of
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
 
-__all__ = ["FoldPieces", "fold_pieces", "FACE_FRACTIONS"]
+from intervalkin.solve.fold_model import FoldModels, side_of
+from intervalkin.solve.fold_side import PAIR, pair_sides
+
+__all__ = ["FoldPieces", "fold_pieces", "FACE_FRACTIONS", "PieceSignatures", "piece_signatures"]
 
 #: Where points are placed on a shared face, as fractions of its two sides.
 FACE_FRACTIONS = ((0.5, 0.5), (0.1, 0.1), (0.1, 0.9), (0.9, 0.1), (0.9, 0.9))
@@ -122,3 +126,75 @@ def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.nd
     good = side != 0
     witness[2 * t[good] + (side[good] > 0)] = inner.reshape(-1, 3)[good]
     return FoldPieces(np.asarray(box, dtype=np.int64), models, e.astype(np.int64), witness)
+
+
+@dataclass(frozen=True, eq=False)
+class PieceSignatures:
+    """The certified signature (count, n_wa1, n_wa2) of each piece of the fold boxes.
+
+    signature : (m, 2, 3) int64, pieces below (0) and above (1) of each fold box, -1 where unknown;
+    empty : (m,) int8, -1 the piece below is proved empty, +1 the piece above, 0 neither;
+    inferred : pieces whose signature came from the other piece and the side of the extra pair
+    (:mod:`intervalkin.solve.fold_side`) or from a piece joined to them, not from a cell.
+    """
+
+    signature: np.ndarray
+    empty: np.ndarray
+    inferred: int
+
+    def counted(self) -> np.ndarray:
+        """(m,) bool: every point of the box off g(S) has a certified signature (each piece known or empty)."""
+        known = self.signature[:, :, 0] >= 0
+        below = known[:, 0] | (self.empty == -1)
+        above = known[:, 1] | (self.empty == 1)
+        return below & above & known.any(axis=1)
+
+
+def piece_signatures(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, pieces: FoldPieces,
+                     from_cells: np.ndarray) -> PieceSignatures:
+    """Signatures of the fold pieces: from their cells, else from the other piece of their box.
+
+    from_cells (2 m, 3): the signature of each piece's cell, -1 where it has none.  For a box
+    with one piece unknown, the side of the extra pair gives it: above = below + s (2, 1, 1)
+    (proofs/lemma-fold-side.md); pieces joined by the piece graph share their signature (a
+    connected set off g(S)); a disagreement would be a soundness bug and is raised.  Certified.
+    """
+    m = len(pieces)
+    n = len(lo)
+    sig = np.asarray(from_cells, dtype=np.int64).reshape(m, 2, 3).copy()
+    before = int(np.count_nonzero(sig[:, :, 0] >= 0))
+    need = np.flatnonzero((sig[:, :, 0] < 0).any(axis=1))
+    side = np.zeros(m, dtype=np.int8)
+    empty = np.zeros(m, dtype=np.int8)
+    if need.size:
+        fs = pair_sides(geometry, np.stack([lo[pieces.box[need]], hi[pieces.box[need]]], axis=-1),
+                        pieces.models.take(need))
+        side[need], empty[need] = fs.side, fs.empty
+    # pieces joined to each other (not to a cell) form groups of one signature
+    e = pieces.edges
+    pp = (e[0] >= n) & (e[1] >= n)
+    a, b = e[0, pp] - n, e[1, pp] - n
+    graph = csr_matrix((np.ones(a.size), (a, b)), shape=(2 * m, 2 * m))
+    _, group = connected_components(graph, directed=False)
+    for _ in range(4):
+        flat = sig.reshape(2 * m, 3)
+        for s, (src, dst) in ((1, (0, 1)), (-1, (1, 0))):
+            # dst = src + s' (2, 1, 1) with s' the side read from src's point of view
+            sel = (side != 0) & (sig[:, src, 0] >= 0) & (sig[:, dst, 0] < 0)
+            sig[sel, dst] = sig[sel, src] + (s * side[sel, None].astype(np.int64)) * PAIR
+        flat = sig.reshape(2 * m, 3)
+        known = flat[:, 0] >= 0
+        rep = np.full((group.max() + 1, 3), -1, dtype=np.int64)
+        rep[group[known]] = flat[known]
+        clash = known & (rep[group] != flat).any(axis=1)
+        if clash.any():
+            raise AssertionError("two joined fold pieces have different signatures (unsound)")
+        grow = ~known & (rep[group, 0] >= 0)
+        if not grow.any():
+            break
+        flat[grow] = rep[group[grow]]
+    checked = (sig[:, :, 0] >= 0).all(axis=1) & (side != 0)
+    bad = checked & ((sig[:, 1] - sig[:, 0]) != side[:, None].astype(np.int64) * PAIR).any(axis=1)
+    if bad.any() or (sig < -1).any():
+        raise AssertionError("a fold box's pieces disagree with the side of its extra pair (unsound)")
+    return PieceSignatures(sig, empty, int(np.count_nonzero(sig[:, :, 0] >= 0)) - before)

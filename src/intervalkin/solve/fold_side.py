@@ -1,0 +1,181 @@
+"""Which piece of a fold box holds the two extra solutions.
+
+A fold model (:mod:`intervalkin.solve.fold_model`) cuts a joint box R into the pieces
+below (q_k < h) and above (q_k > h) the sheet, each of constant count and aspect split,
+and the singular pose X*(p) over each sheet point (p, h(p)) is the only one over R.
+Take ONE sheet point z = (p, h(p)) in the interior of R.  Near z the pieces are the
+points just below and just above z, and every solution over z but X*(p) is regular
+and continues across the sheet; at X*(p) the sign of the curvature f'' of rho_k^2
+along the four-bar curve of legs i, j (:mod:`intervalkin.kinematics.fold_side`) says
+on which side two solutions are born, one per aspect.  So
+
+    signature(above) = signature(below) + s (2, 1, 1),   s = sign f''(X*(p)),
+
+for the whole pieces, not only near z.  One certified point fixes s for the box: a
+few Krawczyk steps at the point parameter p enclose X*(p) in a tight pose box, which
+also encloses h(p) (it must lie strictly inside R_k), and the interval sign of f'' on
+that tight box is s.  A piece that no point of the paving could be placed in, or that
+is joined to no cell, then takes its signature from the other piece.
+See proofs/lemma-fold-side.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import Interval
+from intervalkin.kinematics.enclosures import det_a_gradient_interval, jacobian_interval, rho_sq_leg_interval
+from intervalkin.kinematics.fold_side import pair_side
+from intervalkin.solve.fold_model import SIDE_STEPS, FoldModels, krawczyk_image, normal_signs, preconditioned
+
+__all__ = ["pair_sides", "FoldSides", "PAIR", "GRID", "BISECTIONS"]
+
+#: The signature change (count, n_wa1, n_wa2) from the piece below to the piece above when s = +1.
+PAIR = np.array([2, 1, 1], dtype=np.int64)
+#: The grid of parameters p (fractions of the box's two parameter sides) searched for a sheet point.
+GRID = (0.0, 0.5, 1.0)
+#: Krawczyk steps with a preconditioner recomputed on the shrunk box (after the model's SIDE_STEPS).
+TIGHT_STEPS = 2
+#: Bisection steps along a grid segment whose ends lie on either side of the box's middle height.
+BISECTIONS = 12
+
+
+def _sheet_pose(geometry: Geometry, models: FoldModels, rows: np.ndarray, k: int, p: np.ndarray,
+                tight: bool = True) -> np.ndarray:
+    """Enclosures (m, 3, 2) of X*(p) for point parameters p (m, 2) of the models ``rows`` (axis k); NaN where lost.
+
+    Krawczyk steps with the model's preconditioner first, then (``tight``) TIGHT_STEPS with one recomputed
+    over the current, smaller box (any preconditioner keeps every zero of the box, so each
+    intersection still holds X*(p)).
+    """
+    X = models.pose[rows].copy()
+    P = Interval.point(p)
+    for step in range(SIDE_STEPS + (TIGHT_STEPS if tight else 0)):
+        if step < SIDE_STEPS:
+            Y, C = models.inv[rows], models.contraction[rows]
+        else:
+            safe = np.where(np.isfinite(X), X, 0.0)
+            Y, C = preconditioned((jacobian_interval(geometry, safe), det_a_gradient_interval(geometry, safe)), k)
+        K = krawczyk_image(geometry, np.where(np.isfinite(X), X, 0.0), k, P, Y, C)
+        with np.errstate(invalid="ignore"):
+            X = np.stack([np.fmax(X[:, :, 0], K[:, :, 0]), np.fmin(X[:, :, 1], K[:, :, 1])], axis=-1)
+            bad = ~np.isfinite(K).all(axis=(1, 2)) | ~np.isfinite(X).all(axis=(1, 2)) | (X[:, :, 0] > X[:, :, 1]).any(axis=1)
+        X[bad] = np.nan
+    return X
+
+
+class _Search:
+    """The fold boxes of one axis k still without a proved side, and how to try a parameter point on them."""
+
+    def __init__(self, geometry: Geometry, R: np.ndarray, models: FoldModels, k: int, out: np.ndarray):
+        self.geometry, self.R, self.models, self.k, self.out = geometry, R, models, k, out
+        self.i, self.j = [a for a in range(3) if a != k]
+        # h^2 must exceed lo_k^2 and stay below hi_k^2, both rounded towards the box
+        self.lo2 = Interval.point(R[:, k, 0]).sqr().hi
+        self.hi2 = Interval.point(R[:, k, 1]).sqr().lo
+
+    def point(self, rows: np.ndarray, f: np.ndarray) -> np.ndarray:
+        """Parameters p (m, 2) at fractions f (m, 2) of the rows' parameter sides."""
+        R, i, j = self.R, self.i, self.j
+        return np.stack([R[rows, i, 0] + f[:, 0] * (R[rows, i, 1] - R[rows, i, 0]),
+                         R[rows, j, 0] + f[:, 1] * (R[rows, j, 1] - R[rows, j, 0])], axis=1)
+
+    def heights(self, rows: np.ndarray, p: np.ndarray, tight: bool = True) -> Interval:
+        """Enclosures of h(p)^2 (NaN where X*(p) was lost), recording the sides proved at interior sheet points."""
+        R, k = self.R, self.k
+        X = _sheet_pose(self.geometry, self.models, rows, k, p, tight)
+        fin = np.isfinite(X).all(axis=(1, 2))
+        h2 = rho_sq_leg_interval(self.geometry, np.where(fin[:, None, None], X, 0.0), k)
+        h2.lo[~fin], h2.hi[~fin] = np.nan, np.nan
+        interior = ((p > R[rows][:, [self.i, self.j], 0]) & (p < R[rows][:, [self.i, self.j], 1])).all(axis=1)
+        ok = fin & interior & (h2.lo > self.lo2[rows]) & (h2.hi < self.hi2[rows])
+        if ok.any():
+            s = pair_side(self.geometry, X[ok], np.full(int(ok.sum()), k))
+            at = rows[ok]
+            self.out[at] = np.where(self.out[at] != 0, self.out[at], s)
+        return h2
+
+
+@dataclass(frozen=True, eq=False)
+class FoldSides:
+    """Per fold box: ``side`` (+1: the piece above holds the extra pair of solutions, -1: the piece
+    below, 0: not proved) and ``empty`` (-1: the piece below is proved empty, +1: the piece above,
+    0: neither proved)."""
+
+    side: np.ndarray
+    empty: np.ndarray
+
+
+def pair_sides(geometry: Geometry, joint_boxes: np.ndarray, models: FoldModels) -> FoldSides:
+    """The side of the extra pair, and the empty pieces, of fold boxes (n, 3, 2) with their models.
+
+    Certified (module docstring): a side comes from one sheet point strictly inside the box at
+    which the curvature's sign is proved on an enclosure of the singular pose.  The point is
+    looked for at the centre, on a grid of parameters (its corners included), then by bisection
+    along a grid segment whose ends lie below and above a height inside the box (float heights
+    only steer the search; the point found is checked with intervals).  A piece is proved empty
+    when h is monotone in both parameters (certified signs of the normal over the model's pose
+    box) and its value at the extreme corner, enclosed, lies beyond the box's face.
+    """
+    R = np.asarray(joint_boxes, dtype=np.float64)
+    out = np.zeros(len(R), dtype=np.int8)
+    empty = np.zeros(len(R), dtype=np.int8)
+    grid = np.array([(a, b) for a in GRID for b in GRID])
+    for k in range(3):
+        search = _Search(geometry, R, models, k, out)
+        todo = np.flatnonzero(models.ok & (models.axis == k))
+        for tight in (False, True):  # most sheets are placed without the recomputed preconditioner
+            search.heights(todo, search.point(todo, np.full((todo.size, 2), 0.5)), tight)
+            todo = todo[out[todo] == 0]
+        if todo.size == 0:
+            continue
+        h2 = [search.heights(todo, search.point(todo, np.broadcast_to(f, (todo.size, 2))), tight=False) for f in grid]
+        h = np.sqrt(np.stack([0.5 * (e.lo + e.hi) for e in h2], axis=1))
+        keep = out[todo] == 0
+        todo, h = todo[keep], h[keep]
+        _empty_pieces(geometry, search, todo, empty)
+        # bisect from the grid's lowest point to its highest, onto a height inside the box
+        with np.errstate(invalid="ignore"):
+            lo_at = np.argmin(np.where(np.isfinite(h), h, np.inf), axis=1)
+            hi_at = np.argmax(np.where(np.isfinite(h), h, -np.inf), axis=1)
+        rows = np.arange(todo.size)
+        h_min, h_max = h[rows, lo_at], h[rows, hi_at]
+        target = 0.5 * (np.maximum(h_min, R[todo, k, 0]) + np.minimum(h_max, R[todo, k, 1]))
+        both = (h_min < target) & (target < h_max) & (empty[todo] == 0)
+        todo, a, b, target = todo[both], grid[lo_at[both]], grid[hi_at[both]], target[both]
+        for step in range(BISECTIONS + 1):
+            if todo.size == 0:
+                break
+            mid = 0.5 * (a + b)
+            e = search.heights(todo, search.point(todo, mid), tight=step == BISECTIONS)
+            hm = np.sqrt(0.5 * (e.lo + e.hi))
+            keep = (out[todo] == 0) & np.isfinite(hm)
+            up = hm > target
+            b = np.where(up[:, None], mid, b)
+            a = np.where(up[:, None], a, mid)
+            todo, a, b, target = todo[keep], a[keep], b[keep], target[keep]
+    return FoldSides(out, empty)
+
+
+def _empty_pieces(geometry: Geometry, search: _Search, rows: np.ndarray, empty: np.ndarray) -> None:
+    """Prove pieces of the rows' boxes empty where h is monotone in both parameters (sets ``empty``)."""
+    k, i, j, R = search.k, search.i, search.j, search.R
+    sg = normal_signs(geometry, search.models.pose[rows]).astype(np.int64)
+    mono = (sg[:, i] != 0) & (sg[:, j] != 0) & (sg[:, k] != 0)
+    rows, sg = rows[mono], sg[mono]
+    if rows.size == 0:
+        return
+    # dh/dr_a = -rho_a w_a / (rho_k w_k): the corner where h is largest takes the upper end where it rises
+    rise = np.stack([-sg[:, i] * sg[:, k] > 0, -sg[:, j] * sg[:, k] > 0], axis=1).astype(np.float64)
+    top = search.heights(rows, search.point(rows, rise))
+    low = search.heights(rows, search.point(rows, 1.0 - rise))
+    # h <= h(top corner) <= lo_k everywhere: nothing lies below the sheet (lo_k^2 rounded down)
+    lo_down = Interval.point(R[rows, k, 0]).sqr().lo
+    hi_up = Interval.point(R[rows, k, 1]).sqr().hi
+    below_empty = top.hi <= lo_down
+    above_empty = low.lo >= hi_up
+    empty[rows[below_empty]] = -1
+    empty[rows[above_empty & ~below_empty]] = 1

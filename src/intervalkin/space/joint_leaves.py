@@ -1,0 +1,128 @@
+"""The leaves of the adaptive joint paving: bisection fronts, their tests, and refinement.
+
+The joint box is bisected level by level (:func:`adaptive_leaves`); every box is tested
+by the clear-box search (:func:`intervalkin.solve.joint_box.live_cells`), which also
+narrows the live torus cells that a box hands to its 8 children, so each level re-tests
+only what its parent could not settle.  :func:`refine_leaves` splits chosen leaves once
+more (local refinement, faces, joins).  Leaves travel as the tuple (level, ijk, lo, hi,
+clear, owner, cells): owner/cells are the live torus cells of the undecided leaves,
+sorted by owner.  Certified: a leaf is ``clear`` only when the search proved it off g(S).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from intervalkin.core.geometry import Geometry
+from intervalkin.paving.labels import Label
+from intervalkin.paving.tree import Paving, box_bounds, split_boxes
+from intervalkin.solve.joint_box import initial_cells, live_cells
+
+__all__ = ["adaptive_leaves", "refine_leaves", "leaves_to_paving", "Leaves"]
+
+#: (level, ijk, lo, hi, clear, owner, cells)
+Leaves = tuple[np.ndarray, ...]
+
+
+@dataclass
+class _Front:
+    """Boxes waiting for their test, with the torus cells their parent left live (owner = row)."""
+
+    level: np.ndarray
+    ijk: np.ndarray
+    owner: np.ndarray
+    cells: np.ndarray
+
+
+def _children(front: _Front, cut: np.ndarray) -> _Front:
+    """The 8 children of the cut boxes of a tested front; each inherits its parent's live cells."""
+    rank = np.cumsum(cut) - 1
+    sel = cut[front.owner]
+    c = rank[front.owner[sel]]
+    child = (8 * c[:, None] + np.arange(8)[None, :]).ravel()
+    order = np.argsort(child, kind="stable")
+    level, ijk = split_boxes(front.level[cut], front.ijk[cut])
+    return _Front(level, ijk, child[order], np.repeat(front.cells[sel], 8, axis=0)[order])
+
+
+def _test(geometry: Geometry, domain: np.ndarray, front: _Front) -> tuple[np.ndarray, np.ndarray, np.ndarray, _Front]:
+    """Test a front: (lo, hi, clear mask, the front with its cells updated)."""
+    lo, hi = box_bounds(domain, front.level, front.ijk)
+    owner, cells = live_cells(geometry, np.stack([lo, hi], axis=-1), front.owner, front.cells)
+    clear = np.bincount(owner, minlength=len(front.level)) == 0
+    return lo, hi, clear, _Front(front.level, front.ijk, owner, cells)
+
+
+@dataclass
+class _Leaves:
+    """The leaves found so far; the undecided ones keep their live cells for later refinement."""
+
+    parts: list = field(default_factory=list)
+
+    def add(self, front: _Front, lo, hi, clear, keep) -> None:
+        idx = np.flatnonzero(keep)
+        pos = np.full(len(keep), -1)
+        pos[idx] = np.arange(idx.size)
+        sel = keep[front.owner]
+        self.parts.append((front.level[keep], front.ijk[keep], lo[keep], hi[keep], clear[keep],
+                           pos[front.owner[sel]], front.cells[sel]))
+
+    def merge(self) -> tuple[np.ndarray, ...]:
+        offs = np.cumsum([0] + [len(p[0]) for p in self.parts])
+        cols = [np.concatenate([p[i] for p in self.parts]) for i in range(5)]
+        owner = np.concatenate([p[5] + o for p, o in zip(self.parts, offs)])
+        cells = np.concatenate([p[6] for p in self.parts])
+        return (*cols, owner, cells)
+
+
+def adaptive_leaves(geometry: Geometry, domain: np.ndarray, depth: int,
+              progress: Callable[[dict], None] | None) -> tuple[_Leaves, list[dict]]:
+    """Bisect the joint box, keeping clear boxes and splitting the others, down to ``depth``."""
+    owner, cells = initial_cells(1)
+    front = _Front(np.zeros(1, dtype=np.int64), np.zeros((1, 3), dtype=np.int64), owner, cells)
+    leaves = _Leaves()
+    stats: list[dict] = []
+    dom_vol = float(np.prod(domain[:, 1] - domain[:, 0]))
+    for lev in range(depth + 1):
+        t0 = time.perf_counter()
+        lo, hi, clear, front = _test(geometry, domain, front)
+        cut = ~clear if lev < depth else np.zeros(len(clear), dtype=bool)
+        leaves.add(front, lo, hi, clear, ~cut)
+        stats.append({"stage": "joint paving", "level": lev, "depth": depth, "boxes": int(len(clear)),
+                      "split": int(np.count_nonzero(cut)), "live_cells": int(front.owner.size),
+                      "seconds": time.perf_counter() - t0,
+                      "undecided_volume": {"clear": dom_vol * 8.0 ** (-lev) * int(np.count_nonzero(~clear))}})
+        if progress is not None:
+            progress(stats[-1])
+        if not np.any(cut):
+            break
+        front = _children(front, cut)
+    return leaves, stats
+
+
+def leaves_to_paving(domain: np.ndarray, leaves: tuple[np.ndarray, ...], stats: list[dict]) -> Paving:
+    level, ijk, lo, hi, clear = leaves[:5]
+    lab = np.where(clear, Label.INSIDE, Label.BOUNDARY).astype(np.uint8)
+    return Paving(domain=domain, depth=int(level.max()), level=level.astype(np.int8), ijk=ijk, lo=lo, hi=hi,
+                  labels={"clear": lab}, stats=stats)
+
+
+def refine_leaves(geometry: Geometry, domain: np.ndarray, leaves: tuple[np.ndarray, ...], wall: np.ndarray):
+    """Split the wall leaves once and test their children (inheriting the walls' live cells)."""
+    level, ijk, lo, hi, clear, owner, cells = leaves
+    sel = wall[owner]
+    rank = np.cumsum(wall) - 1
+    front = _Front(level[wall], ijk[wall], rank[owner[sel]], cells[sel])
+    front = _children(front, np.ones(len(front.level), dtype=bool))
+    clo, chi, cclear, front = _test(geometry, domain, front)
+    out = _Leaves()
+    keep = ~wall
+    pos = np.full(len(keep), -1)
+    pos[keep] = np.arange(np.count_nonzero(keep))
+    out.parts.append((level[keep], ijk[keep], lo[keep], hi[keep], clear[keep], pos[owner[~sel]], cells[~sel]))
+    out.add(front, clo, chi, cclear, np.ones(len(cclear), dtype=bool))
+    return out.merge()
