@@ -64,6 +64,21 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
                                for f in frags[:8]) + (" ..." if len(frags) > 8 else "") + ".\n")
     ufp = jc.get("unjoined_fold_pieces") or {}
     if ufp.get("groups"):
-        out.append(f"Fold pieces joined to no cell: {ufp['groups']} groups, volume {ufp['volume']:.2f} "
-                   "(counted as undecided).\n")
+        out.append(f"Fold pieces joined to no cell: {ufp['groups']} groups, volume {ufp['volume']:.2f}; "
+                   f"{jc.get('inferred_piece_signatures', 0)} pieces get their count from the other piece of their "
+                   f"box (the side of the extra pair is proved at a sheet point) and {jc.get('empty_pieces', 0)} "
+                   "are proved empty.\n")
+    places = jc.get("open_places") or {}
+    if places.get("count"):
+        out += [f"What is left open: {places['count']} places (face-connected groups of leaves without a "
+                f"certified count), {places['volume_without_model']:.2f} of volume without a local model. "
+                "A cell could hide in a place, or two cells meet through one, so no upper bound is proved. "
+                "The largest:\n",
+                "| volume | leaves | without a model | from (rho_1, rho_2, rho_3) | to | on a face |",
+                "|---|---|---|---|---|---|"]
+        for q in places["largest"][:10]:
+            out.append(f"| {q['volume']:.3f} | {q['leaves']} | {q['without_model']} | "
+                       f"({', '.join(f'{v:.2f}' for v in q['lo'])}) | ({', '.join(f'{v:.2f}' for v in q['hi'])}) | "
+                       f"{'yes' if q['on_face'] else 'no'} |")
+        out.append("")
     return out

@@ -129,6 +129,9 @@ def joint_cells_summary(jp) -> dict:
         "boxes_cleared_by_exclusion": {"boxes": int(fs.get("void_boxes", 0)), "volume": float(fs.get("void_volume", 0.0))},
         "unjoined_fold_pieces": {"groups": int(fs.get("unjoined_piece_groups", 0)),
                                  "volume": float(fs.get("unjoined_piece_volume", 0.0))},
+        "inferred_piece_signatures": int(fs.get("inferred_piece_signatures", 0)),
+        "empty_pieces": int(fs.get("empty_pieces", 0)),
+        "open_places": jp.open_places()["places"],
         "certified": "every box of a cell is proved off g(S) (no singular pose has its joint vector in it: by the "
                      "torus search or by Krawczyk exclusion), or is a fold box: one sheet of g(S) crosses it as a "
                      "certified graph and each of its two pieces is joined to the cell through a point placed in "
@@ -137,7 +140,10 @@ def joint_cells_summary(jp) -> dict:
                      "components; fragments are certified islands inside the undecided layer, made only by the "
                      "local refinement and touching no face of the joint box: each lies in some component but is "
                      "not joined to one, so they are listed, not counted; fold pieces joined to no clear box are "
-                     "counted under unjoined_fold_pieces (their counts are not computed)",
+                     "counted under unjoined_fold_pieces and get their count from the other piece of their box "
+                     "(the side of the extra pair of solutions is proved at one sheet point) or are proved "
+                     "empty (inferred_piece_signatures, empty_pieces); open_places lists the face-connected "
+                     "groups of leaves not certified (no local model, or a piece of unknown count)",
     }
 
 

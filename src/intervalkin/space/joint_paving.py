@@ -55,6 +55,7 @@ from intervalkin.space.joint_leaves import adaptive_leaves, leaves_to_paving, re
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
 from intervalkin.space.joint_models import ModelStore
 from intervalkin.space.joint_pieces import FoldPieces, PieceSignatures, piece_signatures
+from intervalkin.space.joint_places import open_places
 
 __all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain", "DEFAULT_JOINT_DEPTH", "JOIN_LEVELS", "MODEL_LEVELS"]
 
@@ -109,13 +110,25 @@ class JointSpacePaving:
 
     def open_places(self) -> dict:
         """What the paving leaves open (the ``undecided`` block of the counts it backs): the volume of undecided
-        leaves, the certified share, the fragments and the fold pieces joined to no cell."""
+        leaves, the certified share, the fragments, the fold pieces joined to no cell, and the places
+        (face-connected groups of open leaves, :mod:`intervalkin.space.joint_places`), the largest listed."""
         fs = self.fold_stats
+        open_leaf = (self.cell < 0) & ~self.counted_fold_mask()
+        no_model = self.cell < 0
+        if self.pieces is not None and len(self.pieces):
+            no_model[self.pieces.box] = False
+        p = self.paving
+        n, largest = open_places(p.level, p.ijk, p.lo, p.hi, open_leaf, no_model, p.domain)
         return {"joint_volume": self.undecided_volume(), "joint_certified_share": self.certified_share(),
                 "fragments": [{"count": c.count, "volume": c.volume, "witness": [str(v) for v in c.witness]}
                               for c in self.fragments],
                 "unjoined_fold_pieces": {"groups": int(fs.get("unjoined_piece_groups", 0)),
-                                         "volume": float(fs.get("unjoined_piece_volume", 0.0))}}
+                                         "volume": float(fs.get("unjoined_piece_volume", 0.0))},
+                "places": {"count": n, "volume_without_model": float(p.volume()[no_model].sum()),
+                           "why": "no local model: the Krawczyk test of the singular four-bar system failed for "
+                                  "every axis (near cusp edges and crossings of g(S)); or a fold box with a piece "
+                                  "of unknown count",
+                           "largest": [q.to_json() for q in largest]}}
 
     def undecided_volume(self) -> float:
         """Volume of the leaves that are neither clear nor fold boxes with both pieces counted."""

@@ -1,0 +1,75 @@
+"""The places a joint paving leaves open: where a hidden cell or a missing join could still be.
+
+An *open leaf* is a leaf of the joint paving whose points do not all have a certified
+signature: an undecided leaf without a local model, or a fold box one of whose pieces
+has no known signature.  The open leaves fall into face-connected groups, the *places*;
+each is reported with its bounding box, volume, number of leaves, the share of them
+that have no model, and whether it touches a face of the joint box.  A place is where
+an upper bound on the number of cells fails today: a cell could hide inside it, or two
+cells could meet through it (issue 14).  Nothing here is a certified claim; it is the
+exact list of what the certified labels do not cover.
+
+Why a leaf has no model: the parametric Krawczyk test of its singular four-bar system
+(:mod:`intervalkin.solve.fold_model`) failed for every axis.  Near a cusp edge of g(S) the
+kernel of A becomes tangent to S and that system's Jacobian is singular for every axis;
+where two sheets of g(S) cross, the live torus cells form two groups that are both
+non-empty; both need models with more than one sheet (DESIGN.md section 8).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
+
+from intervalkin.paving.adjacency import shares_face
+
+__all__ = ["OpenPlace", "open_places", "PLACES_LISTED"]
+
+#: The largest places listed one by one (the totals cover all of them).
+PLACES_LISTED = 40
+
+
+@dataclass(frozen=True)
+class OpenPlace:
+    """A face-connected group of open leaves: bounding box (3, 2) lists, volume, leaves, how many lack a model."""
+
+    lo: tuple[float, float, float]
+    hi: tuple[float, float, float]
+    volume: float
+    leaves: int
+    without_model: int
+    on_face: bool
+
+    def to_json(self) -> dict:
+        return {"lo": list(self.lo), "hi": list(self.hi), "volume": self.volume, "leaves": self.leaves,
+                "without_model": self.without_model, "on_face": self.on_face}
+
+
+def open_places(level: np.ndarray, ijk: np.ndarray, lo: np.ndarray, hi: np.ndarray, open_leaf: np.ndarray,
+                no_model: np.ndarray, domain: np.ndarray) -> tuple[int, list[OpenPlace]]:
+    """(number of places, the largest :data:`PLACES_LISTED` of them by volume).
+
+    open_leaf (n,) bool: the open leaves; no_model (n,) bool: those without a local model.
+    """
+    idx = np.flatnonzero(open_leaf)
+    if idx.size == 0:
+        return 0, []
+    depth = int(np.asarray(level)[idx].max())
+    e = shares_face(level[idx], ijk[idx], depth, periodic=(False, False, False))
+    g = csr_matrix((np.ones(e.shape[1]), (e[0], e[1])), shape=(idx.size, idx.size))
+    n, lab = connected_components(g, directed=False)
+    vol = np.prod(hi[idx] - lo[idx], axis=1)
+    total = np.bincount(lab, weights=vol, minlength=n)
+    top = np.argsort(-total, kind="stable")[:PLACES_LISTED]
+    out = []
+    touch = ((lo[idx] <= domain[:, 0]) | (hi[idx] >= domain[:, 1])).any(axis=1)
+    for c in top:
+        m = lab == c
+        out.append(OpenPlace(tuple(float(v) for v in lo[idx][m].min(axis=0)),
+                             tuple(float(v) for v in hi[idx][m].max(axis=0)),
+                             float(total[c]), int(m.sum()), int(np.count_nonzero(no_model[idx][m])),
+                             bool(touch[m].any())))
+    return int(n), out
