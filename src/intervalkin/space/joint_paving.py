@@ -51,6 +51,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.paving.budget import check_depth
 from intervalkin.paving.tree import Paving
 from intervalkin.solve.fold_model import side_of
+from intervalkin.solve.fold_side import side_of_tight
 from intervalkin.space.joint_leaves import adaptive_leaves, leaves_to_paving, refine_leaves
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
 from intervalkin.space.joint_models import ModelStore
@@ -183,6 +184,9 @@ class JointSpacePaving:
         at = np.flatnonzero((out[:, 0] < 0) & (t >= 0))
         if at.size:
             side = side_of(geometry, self.pieces.models, t[at], q[at])
+            near = np.flatnonzero(side == 0)  # close to the sheet: the tight enclosure of its pose decides
+            if near.size:
+                side[near] = side_of_tight(geometry, self.pieces.models, t[at][near], q[at][near])
             sig = self.piece_signatures.signature[t[at], (side > 0).astype(np.int64)]
             out[at] = np.where((side != 0)[:, None], sig, -1)
         return out
