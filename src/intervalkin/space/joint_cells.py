@@ -89,6 +89,7 @@ class CellSolver:
         self.geometry = geometry
         self._solved: dict[int, tuple[tuple[int, int, int], tuple[Fraction, Fraction, Fraction]]] = {}
         self.edges: np.ndarray = np.zeros((2, 0), dtype=np.int64)
+        self._edges_of: tuple = ()  # (depth, level, ijk) of the paving ``edges`` belong to
         #: (groups, volume) of fold pieces joined to no clear box at the last labelling
         self.unjoined: tuple[int, float] = (0, 0.0)
 
@@ -99,6 +100,15 @@ class CellSolver:
             n1 = sum(1 for s in res.solutions if s.aspect == "WA1")
             return (res.count, n1, res.count - n1), witness
         return (-1, -1, -1), witness
+
+    def _face_edges(self, paving: Paving, fine_depth: int) -> np.ndarray:
+        """The face-adjacent pairs of the paving's leaves; the last ones again when the leaves did not change."""
+        was = self._edges_of
+        if not (was and was[0] == fine_depth and np.array_equal(was[1], paving.level)
+                and np.array_equal(was[2], paving.ijk)):
+            self.edges = shares_face(paving.level, paving.ijk, fine_depth, periodic=_NOWRAP)
+            self._edges_of = (fine_depth, paving.level.copy(), paving.ijk.copy())
+        return self.edges
 
     def label(self, paving: Paving, fine_depth: int,
               pieces_of: Callable[[np.ndarray], FoldPieces | None] | None = None,
@@ -114,7 +124,7 @@ class CellSolver:
         """
         ok = paving.labels["clear"] == Label.INSIDE
         n = len(paving)
-        self.edges = shares_face(paving.level, paving.ijk, fine_depth, periodic=_NOWRAP)
+        self.edges = self._face_edges(paving, fine_depth)
         pieces = pieces_of(self.edges) if pieces_of is not None else None
         m2 = 2 * len(pieces) if pieces is not None else 0
         if m2:
