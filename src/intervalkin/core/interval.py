@@ -290,13 +290,43 @@ class Interval:
         return _trig(self, np.sin, max_at=1, min_at=3)
 
 
+#: Margin of the screen of :func:`_may_contain_multiple`, in turns (units of 2 pi): far above the
+#: float error of the screen (below 1e-14 turns for |t| <= TRIG_MAX_ARG) and of the enclosures of n pi / 2.
+_SCREEN = 1e-6
+_INV_TWO_PI = 0.5 / PI_LO
+
+
 def _may_contain_multiple(lo: np.ndarray, hi: np.ndarray, j: int) -> np.ndarray:
     """True where [lo, hi] may contain a point (4k + j) * pi / 2 for an integer k.
 
     The enclosure [n * PI_LO / 2, n * PI_HI / 2] (rounded outward) of n * pi / 2 is
     tested against [lo, hi] for the three candidate k around hi; the interval is
     shorter than 2 pi when this is called, so no other k can fall inside.
+
+    Most intervals are far from every such point, so a float screen runs first: in
+    turns from j pi / 2, an interval whose ends widened by ``_SCREEN`` hold no integer
+    is more than 6e-6 from every candidate, where the enclosures (a few ulps wide)
+    cannot reach it; only the rest get the outward-rounded test, so the answer is
+    the same as testing every entry.
     """
+    lo_f, hi_f = np.ravel(lo), np.ravel(hi)
+    with np.errstate(invalid="ignore", over="ignore"):  # inf and NaN ends fall to the rounded test
+        s = lo_f - j * (PI_LO / 2)
+        s *= _INV_TWO_PI
+        s -= _SCREEN
+        e = hi_f - j * (PI_LO / 2)
+        e *= _INV_TWO_PI
+        e += _SCREEN
+        near = ~(np.floor(e, out=e) < np.ceil(s, out=s))
+    hit = np.zeros(lo_f.shape, dtype=bool)
+    at = np.flatnonzero(near)
+    if at.size:
+        hit[at] = _rounded_test(lo_f[at], hi_f[at], j)
+    return hit.reshape(np.shape(lo))
+
+
+def _rounded_test(lo: np.ndarray, hi: np.ndarray, j: int) -> np.ndarray:
+    """The outward-rounded test of :func:`_may_contain_multiple` for the three candidates around hi."""
     k0 = np.floor((hi - j * PI_LO / 2) / (2 * PI_LO))
     hit = np.zeros(np.shape(lo), dtype=bool)
     for dk in (-1.0, 0.0, 1.0):

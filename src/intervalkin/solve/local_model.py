@@ -32,14 +32,16 @@ __all__ = ["cluster_cells", "local_models", "MAX_GROUPED"]
 
 #: Boxes with more live cells than this keep them in one group (the pairwise contact test is quadratic).
 MAX_GROUPED = 96
+#: Pairs of cells tested together.
+_PAIRS = 1 << 16
 
 
-def _touch(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cells a and b (m, 4) [theta_lo, theta_hi, phi_lo, phi_hi] share a point of the torus (closed cells)."""
+def _touch(a: list[np.ndarray], b: list[np.ndarray]) -> np.ndarray:
+    """Cells a and b, as columns [theta_lo, theta_hi, phi_lo, phi_hi] of (m,), share a point of the torus (closed cells)."""
     def axis(lo, hi):
-        meet = (a[:, lo] <= b[:, hi]) & (b[:, lo] <= a[:, hi])
+        meet = (a[lo] <= b[hi]) & (b[lo] <= a[hi])
         # the cells tile [-pi, pi]: one ending at the upper seam touches one starting at the lower
-        seam = ((a[:, hi] >= PI_LO) & (b[:, lo] <= -PI_LO)) | ((b[:, hi] >= PI_LO) & (a[:, lo] <= -PI_LO))
+        seam = ((a[hi] >= PI_LO) & (b[lo] <= -PI_LO)) | ((b[hi] >= PI_LO) & (a[lo] <= -PI_LO))
         return meet | seam
     return axis(0, 1) & axis(2, 3)
 
@@ -57,14 +59,18 @@ def cluster_cells(owner: np.ndarray, cells: np.ndarray) -> np.ndarray:
     starts = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
     counts = np.diff(np.r_[starts, m])
     rows, cols = [], []
+    column = [np.ascontiguousarray(cells[:, c]) for c in range(4)]
     for n in np.unique(counts[(counts > 1) & (counts <= MAX_GROUPED)]):
-        first = starts[counts == n]
         a, b = np.triu_indices(int(n), 1)
-        ia = (first[:, None] + a[None, :]).ravel()
-        ib = (first[:, None] + b[None, :]).ravel()
-        hit = _touch(cells[ia], cells[ib])
-        rows.append(ia[hit])
-        cols.append(ib[hit])
+        every = starts[counts == n]
+        per = max(1, _PAIRS // a.size)
+        for s in range(0, every.size, per):  # cache-sized pieces of pairs
+            first = every[s:s + per]
+            ia = (first[:, None] + a[None, :]).ravel()
+            ib = (first[:, None] + b[None, :]).ravel()
+            hit = _touch([c[ia] for c in column], [c[ib] for c in column])
+            rows.append(ia[hit])
+            cols.append(ib[hit])
     big = np.flatnonzero(counts > MAX_GROUPED)
     for s in big:  # one chain through the box's cells: a single group
         rows.append(np.arange(starts[s], starts[s] + counts[s] - 1))

@@ -89,6 +89,7 @@ class CellSolver:
         self.geometry = geometry
         self._solved: dict[int, tuple[tuple[int, int, int], tuple[Fraction, Fraction, Fraction]]] = {}
         self.edges: np.ndarray = np.zeros((2, 0), dtype=np.int64)
+        self._edges_of: tuple = ()  # (depth, level, ijk) of the paving ``edges`` belong to
         #: (groups, volume) of fold pieces joined to no clear box at the last labelling
         self.unjoined: tuple[int, float] = (0, 0.0)
 
@@ -99,6 +100,15 @@ class CellSolver:
             n1 = sum(1 for s in res.solutions if s.aspect == "WA1")
             return (res.count, n1, res.count - n1), witness
         return (-1, -1, -1), witness
+
+    def _face_edges(self, paving: Paving, fine_depth: int) -> np.ndarray:
+        """The face-adjacent pairs of the paving's leaves; the last ones again when the leaves did not change."""
+        was = self._edges_of
+        if not (was and was[0] == fine_depth and np.array_equal(was[1], paving.level)
+                and np.array_equal(was[2], paving.ijk)):
+            self.edges = shares_face(paving.level, paving.ijk, fine_depth, periodic=_NOWRAP)
+            self._edges_of = (fine_depth, paving.level.copy(), paving.ijk.copy())
+        return self.edges
 
     def label(self, paving: Paving, fine_depth: int,
               pieces_of: Callable[[np.ndarray], FoldPieces | None] | None = None,
@@ -114,7 +124,7 @@ class CellSolver:
         """
         ok = paving.labels["clear"] == Label.INSIDE
         n = len(paving)
-        self.edges = shares_face(paving.level, paving.ijk, fine_depth, periodic=_NOWRAP)
+        self.edges = self._face_edges(paving, fine_depth)
         pieces = pieces_of(self.edges) if pieces_of is not None else None
         m2 = 2 * len(pieces) if pieces is not None else 0
         if m2:
@@ -231,6 +241,7 @@ def joining_paths(edges: np.ndarray, cell: np.ndarray, cells: list[JointSpaceCel
         return out
     undecided = cell < 0
     a, b = edges
+    size = n + len(cells)
     for ids in groups.values():
         member = np.zeros(len(cells), dtype=bool)
         member[ids] = True
@@ -239,16 +250,49 @@ def joining_paths(edges: np.ndarray, cell: np.ndarray, cells: list[JointSpaceCel
         usable = undecided | ((cell >= 0) & member[np.maximum(cell, 0)])
         keep = usable[a] & usable[b] & (undecided[a] | undecided[b])
         u, v = node[a[keep]], node[b[keep]]
-        graph = csr_matrix((np.ones(u.size), (u, v)), shape=(n + len(cells), n + len(cells)))
-        for k, src in enumerate(ids[:-1]):
-            _, pred = breadth_first_order(graph, n + src, directed=False, return_predecessors=True)
-            for dst in ids[k + 1:]:
-                at = pred[n + dst]
-                while at >= 0 and at != n + src:
-                    if at < n:
-                        out[at] = True
-                    at = pred[at]
+        # only the nodes on an edge take part: renumbered in order, the search visits them in the same order
+        used = np.zeros(size, dtype=bool)
+        used[u] = used[v] = True
+        used[n + np.asarray(ids)] = True
+        old = np.flatnonzero(used)
+        new = np.cumsum(used) - 1
+        graph = _both_ways(new[u], new[v], old.size)
+        _, comp = connected_components(graph, directed=False)
+        cid = new[n + np.asarray(ids)]
+        on_path = np.zeros(old.size, dtype=bool)
+        for k in range(len(ids) - 1):
+            src, dst = cid[k], cid[k + 1:]
+            dst = dst[comp[dst] == comp[src]]  # no chain to a cell of another component
+            if dst.size == 0:
+                continue
+            _, pred = breadth_first_order(graph, src, directed=True, return_predecessors=True)
+            on_path[:] = False
+            at = pred[dst]
+            while at.size:  # up the search tree from every cell at once; shared stretches walked once
+                at = np.unique(at[(at >= 0) & (at != src)])
+                at = at[~on_path[at]]
+                on_path[at] = True
+                at = pred[at]
+            hit = old[on_path]
+            out[hit[hit < n]] = True
     return out
+
+
+def _both_ways(u: np.ndarray, v: np.ndarray, size: int) -> csr_matrix:
+    """The graph of edges (u, v) for a directed search that visits what an undirected one visits, in its order.
+
+    scipy's undirected breadth-first search takes each node's neighbours in the graph,
+    then in its transpose (converted afresh at every call); this graph lists them in that
+    order, so a directed search from any node gives the same predecessors at a fraction
+    of the cost.
+    """
+    g = csr_matrix((np.ones(u.size), (u, v)), shape=(size, size))
+    gt = g.T.tocsr()
+    rows = np.arange(size)
+    at = np.concatenate([np.repeat(rows, np.diff(g.indptr)), np.repeat(rows, np.diff(gt.indptr))])
+    cols = np.concatenate([g.indices, gt.indices])[np.argsort(at, kind="stable")]
+    indptr = g.indptr.astype(np.int64) + gt.indptr.astype(np.int64)
+    return csr_matrix((np.ones(cols.size), cols, indptr), shape=(size, size))
 
 
 def regions_from_cells(cells: Sequence[JointSpaceCell], proved_lower: int = 0, undecided: dict | None = None) -> Count:

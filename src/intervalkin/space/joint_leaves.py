@@ -41,12 +41,21 @@ class _Front:
 def _children(front: _Front, cut: np.ndarray) -> _Front:
     """The 8 children of the cut boxes of a tested front; each inherits its parent's live cells."""
     rank = np.cumsum(cut) - 1
-    sel = cut[front.owner]
+    sel = np.flatnonzero(cut[front.owner])
     c = rank[front.owner[sel]]
-    child = (8 * c[:, None] + np.arange(8)[None, :]).ravel()
-    order = np.argsort(child, kind="stable")
+    # child 8 c + t of parent c gets the parent's run of cells, in order: runs of children follow each other
+    count = np.bincount(c, minlength=int(np.count_nonzero(cut)))
+    start = np.cumsum(count) - count
+    at = 8 * start[c] + (np.arange(sel.size) - start[c])
+    owner = np.empty(8 * sel.size, dtype=np.int64)
+    cells = np.empty((8 * sel.size, front.cells.shape[1]))
+    parent_cells = front.cells[sel]
+    for t in range(8):  # written in place: no (8 m, 4) temporaries besides the result
+        owner[at] = 8 * c + t
+        cells[at] = parent_cells
+        at += count[c]
     level, ijk = split_boxes(front.level[cut], front.ijk[cut])
-    return _Front(level, ijk, child[order], np.repeat(front.cells[sel], 8, axis=0)[order])
+    return _Front(level, ijk, owner, cells)
 
 
 def _test(geometry: Geometry, domain: np.ndarray, front: _Front) -> tuple[np.ndarray, np.ndarray, np.ndarray, _Front]:

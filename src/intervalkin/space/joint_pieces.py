@@ -95,6 +95,19 @@ def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.nd
     use = np.ones(pts.shape[:2], dtype=bool)
     use[(model_of[a] < 0) | (model_of[b] < 0), 1:] = False
     q = pts[use]
+    # two inner witnesses per fold box, near its faces q_k = lo and q_k = hi; placed first, since a
+    # piece's inner witness replaces any face point as its witness
+    inner = np.repeat((0.5 * lo[box] + 0.5 * hi[box])[:, None, :], len(INNER_FRACTIONS), axis=1)
+    rows = np.arange(m)
+    k = models.axis[rows]
+    for c, f in enumerate(INNER_FRACTIONS):
+        inner[rows, c, k] = lo[box, k] + f * (hi[box, k] - lo[box, k])
+    t_in = np.repeat(rows, len(INNER_FRACTIONS))
+    side_in = side_of(geometry, models, t_in, inner.reshape(-1, 3))
+    good = side_in != 0
+    covered = np.zeros(2 * m, dtype=bool)
+    covered[2 * t_in[good] + (side_in[good] > 0)] = True
+    both_covered = covered[0::2] & covered[1::2]
     node = []
     placed = []
     for end in (a, b):
@@ -103,6 +116,11 @@ def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.nd
         nd = end.astype(np.int64)
         ok = np.ones(len(q), dtype=bool)
         is_model = t >= 0
+        if placed:
+            # a point the first end could not place gives no edge, and at the second end only a
+            # witness, which matters only where the box's pieces lack an inner witness
+            is_model &= placed[0] | ~both_covered[np.maximum(t, 0)]
+            ok[(t >= 0) & ~is_model] = False
         if is_model.any():
             side = side_of(geometry, models, t[is_model], q[is_model])
             nd[is_model] = n + 2 * t[is_model] + (side > 0)
@@ -115,16 +133,7 @@ def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.nd
     for nd, ok in zip(node, placed):
         piece = ok & (nd >= n)
         witness[nd[piece] - n] = q[piece]
-    # two inner witnesses per fold box, near its faces q_k = lo and q_k = hi
-    inner = np.repeat((0.5 * lo[box] + 0.5 * hi[box])[:, None, :], len(INNER_FRACTIONS), axis=1)
-    rows = np.arange(m)
-    k = models.axis[rows]
-    for c, f in enumerate(INNER_FRACTIONS):
-        inner[rows, c, k] = lo[box, k] + f * (hi[box, k] - lo[box, k])
-    t = np.repeat(rows, len(INNER_FRACTIONS))
-    side = side_of(geometry, models, t, inner.reshape(-1, 3))
-    good = side != 0
-    witness[2 * t[good] + (side[good] > 0)] = inner.reshape(-1, 3)[good]
+    witness[2 * t_in[good] + (side_in[good] > 0)] = inner.reshape(-1, 3)[good]
     return FoldPieces(np.asarray(box, dtype=np.int64), models, e.astype(np.int64), witness)
 
 
