@@ -66,7 +66,7 @@ def fold_paving(paper_geometry):
     of the ``joint_fold_model`` and ``joint_join`` claims in tests/certify and tests/checker."""
     from intervalkin.space.joint_paving import pave_joint_space
 
-    return pave_joint_space(paper_geometry, 5, 1, fold=True)
+    return pave_joint_space(paper_geometry, 5, 1, fold=True, model_levels=1)
 
 
 SECOND_DESIGN = Path(__file__).parents[1] / "examples" / "second_design_0246.toml"

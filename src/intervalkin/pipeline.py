@@ -55,7 +55,7 @@ from intervalkin.space.basic_region import (
     label_pose,
 )
 from intervalkin.space.joint_cells import regions_from_cells
-from intervalkin.space.joint_paving import JOIN_LEVELS, MODEL_LEVELS, JointSpacePaving
+from intervalkin.space.joint_paving import FACE_LEVELS, JOIN_LEVELS, MODEL_LEVELS, JointSpacePaving
 from intervalkin.space.joint_paving import pave_joint_space as pave_joint_cells
 from intervalkin.space.joint_space import JointPaving, joint_paving
 from intervalkin.space.pose_label import PoseLabel
@@ -325,7 +325,8 @@ def pave_joint_space(geometry: Geometry | None = None, singular_depth: int = DEF
 
 
 def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progress: ProgressCallback | None = None,
-            refine_to: int | None = None) -> Analysis:
+            refine_to: int | None = None,
+            while_waiting: Callable[[RegionAnalysis, JointPaving], None] | None = None) -> Analysis:
     """Run the chain geometry -> singular layer -> joint cells -> regions -> uniqueness domains.
 
     Parameters
@@ -339,6 +340,9 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
         certified box), pave the regions one level deeper, up to this depth.  The paver
         splits only undecided boxes, so a deeper level refines near the characteristic
         surfaces, the singular layer and the joint limits only.
+    while_waiting : work that needs the regions and the joint-space enclosure but not the
+        joint cells (the paper run's trajectories), called with both while the direct joint
+        paving is still running in its second process (the main process would idle).
 
     Raises :class:`~intervalkin.core.errors.InputError` on a bad depth and
     :class:`~intervalkin.core.errors.ResourceError` when the run would not fit in memory.
@@ -348,8 +352,8 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     dw, ds, dj = chain_depths(depth)
     stages = _Stages(progress)
     joint = _joint_space(geometry, ds, dj, stages)
-    name = (f"joint space paved directly (depth {dj - 1}, local models, {MODEL_LEVELS} level of local refinement, "
-            f"{JOIN_LEVELS} join levels)")
+    name = (f"joint space paved directly (depth {dj - 1}, local models, {MODEL_LEVELS} levels of local refinement, "
+            f"{FACE_LEVELS} on the faces, {JOIN_LEVELS} join levels)")
     with contextlib.ExitStack() as side:
         future = None
         daemonic = multiprocessing.current_process().daemon
@@ -365,6 +369,9 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
             regions = analyse_regions(geometry, joint, dw, progress=levels)
         with stages.stage("aspects: covers proving each sign of det A connected"):
             topology = prove_aspects(geometry)
+        if while_waiting is not None:
+            with stages.stage("work beside the joint paving (trajectories)"):
+                while_waiting(regions, joint)
         if future is not None:
             with stages.stage(name + ", in a second process: waiting for it"):
                 cells = future.result()

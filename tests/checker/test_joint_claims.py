@@ -401,7 +401,7 @@ def test_component_joins_link_clear_components(paper_geometry):
     from intervalkin.paving.adjacency import component_labels, shares_face
     from intervalkin.space.joint_paving import pave_joint_space
 
-    jsp = pave_joint_space(paper_geometry, 6, 0, fold=True)
+    jsp = pave_joint_space(paper_geometry, 6, 0, fold=True, model_levels=1)
     models, joins, omitted = joint_claims(paper_geometry, jsp, max_joins=2, max_models=8)
     pav = jsp.paving
     clear = jsp.cell >= 0

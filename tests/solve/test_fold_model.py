@@ -26,7 +26,7 @@ from tests.solve.shared import split_of
 
 @pytest.fixture(scope="module")
 def folds(paper_geometry):
-    jp = pave_joint_space(paper_geometry, 5, join_levels=0, fold=True)
+    jp = pave_joint_space(paper_geometry, 5, join_levels=0, fold=True, model_levels=1)
     assert jp.pieces is not None and len(jp.pieces) >= 100, "depth 5 gives a few hundred fold boxes"
     return jp
 

@@ -55,7 +55,7 @@ def geometry():
 
 @pytest.fixture(scope="module")
 def joint5(geometry):
-    return pave_joint_space(geometry, 5, join_levels=1)
+    return pave_joint_space(geometry, 5, join_levels=1, model_levels=1)
 
 
 def test_the_witnesses_have_the_stated_counts(geometry):

@@ -151,12 +151,19 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
     st = Stages(quiet=quiet or as_json)
     with folder.recording():
         _begin(folder, geometry)
-        a = analyse(geometry, depth, progress=st, refine_to=refine_to)
+        early: dict = {}
+
+        def beside(regions, joint):  # the paths need the regions, not the joint cells: found while those are paved
+            early["paths"] = _table1_paths(geometry, regions, joint, st)
+
+        a = analyse(geometry, depth, progress=st, refine_to=refine_to,
+                    while_waiting=beside if paper and refine_to is None else None)
         summary = write_chain(a, out, figures=figures, stages=st)
         trajs = []
         if paper:  # before the certificates, which re-check these paths
             st.start("certified trajectories between Table 1's solutions 2, 3, 6")
-            summary["trajectories"], trajs = _paper_trajectories(a, out, summary["files"], st)
+            paths = early.get("paths") or _table1_paths(geometry, a.regions, a.joint, st)
+            summary["trajectories"], trajs = _paper_trajectories(a, out, summary["files"], paths)
             st.done()
         if certificates:
             st.start("certificates")
@@ -179,18 +186,25 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
     return 0
 
 
-def _paper_trajectories(a: Analysis, out: Path, files: list[str], st: Stages) -> tuple[list[dict], list]:
-    """Certified non-singular paths between Table 1's solutions 2, 3 and 6 (paper section 3.2, Fig. 13).
-
-    Returns the report entries (one per pair, failures included) and the
-    :class:`~intervalkin.space.trajectory.Trajectory` objects found (for the certificates).
-    """
-    done, found = [], []
+def _table1_paths(geometry, regions, joint, st: Stages) -> list[tuple[int, int, object]]:
+    """Certified non-singular paths between Table 1's solutions 2, 3 and 6 (paper section 3.2, Fig. 13):
+    (i, j, the :class:`~intervalkin.space.trajectory.Trajectory` or the error that stopped it)."""
+    out = []
     for i, j in st.iterate(((2, 3), (2, 6), (3, 6)), "trajectories"):
         try:
-            tr = trajectory(a.geometry, TABLE1_RHO, i, j, analysis=a.regions, joint=a.joint)
+            out.append((i, j, trajectory(geometry, TABLE1_RHO, i, j, analysis=regions, joint=joint)))
         except IntervalkinError as exc:
-            done.append({"from": i, "to": j, "certified": False, "reason": str(exc)})
+            out.append((i, j, exc))
+    return out
+
+
+def _paper_trajectories(a: Analysis, out: Path, files: list[str], paths) -> tuple[list[dict], list]:
+    """The files and report entries of the Table 1 paths (one entry per pair, failures included), and the
+    :class:`~intervalkin.space.trajectory.Trajectory` objects found (for the certificates)."""
+    done, found = [], []
+    for i, j, tr in paths:
+        if isinstance(tr, IntervalkinError):
+            done.append({"from": i, "to": j, "certified": False, "reason": str(tr)})
             continue
         folder = out / "trajectories" / f"{i}-{j}"
         for path in write_trajectory(tr, a.geometry, folder, paving=a.regions.paving, joint=a.joint):

@@ -35,8 +35,9 @@ __all__ = ["pair_sides", "side_of_tight", "FoldSides", "PAIR", "GRID", "BISECTIO
 
 #: The signature change (count, n_wa1, n_wa2) from the piece below to the piece above when s = +1.
 PAIR = np.array([2, 1, 1], dtype=np.int64)
-#: The grid of parameters p (fractions of the box's two parameter sides) searched for a sheet point.
-GRID = (0.0, 0.5, 1.0)
+#: The parameters p (fractions of the box's two parameter sides) where the sheet's height is enclosed
+#: after the centre: the corners, where a monotone height takes its extremes (corner (a, b) at 2 a + b).
+GRID = ((0.0, 0.0), (0.0, 1.0), (1.0, 0.0), (1.0, 1.0))
 #: Krawczyk steps with a preconditioner recomputed on the shrunk box (after the model's SIDE_STEPS).
 TIGHT_STEPS = 2
 #: Bisection steps along a grid segment whose ends lie on either side of the box's middle height.
@@ -114,8 +115,7 @@ def pair_sides(geometry: Geometry, joint_boxes: np.ndarray, models: FoldModels) 
 
     Certified (module docstring): a side comes from one sheet point strictly inside the box at
     which the curvature's sign is proved on an enclosure of the singular pose.  The point is
-    looked for at the centre, on a grid of parameters (its corners included), then by bisection
-    along a grid segment whose ends lie below and above a height inside the box (float heights
+    looked for at the centre, at the corners, then by bisection along the segment whose ends lie below and above a height inside the box (float heights
     only steer the search; the point found is checked with intervals).  A piece is proved empty
     when h is monotone in both parameters (certified signs of the normal over the model's pose
     box) and its value at the extreme corner, enclosed, lies beyond the box's face.
@@ -123,20 +123,21 @@ def pair_sides(geometry: Geometry, joint_boxes: np.ndarray, models: FoldModels) 
     R = np.asarray(joint_boxes, dtype=np.float64)
     out = np.zeros(len(R), dtype=np.int8)
     empty = np.zeros(len(R), dtype=np.int8)
-    grid = np.array([(a, b) for a in GRID for b in GRID])
+    grid = np.array(GRID, dtype=np.float64)
     for k in range(3):
         search = _Search(geometry, R, models, k, out)
         todo = np.flatnonzero(models.ok & (models.axis == k))
-        for tight in (False, True):  # most sheets are placed without the recomputed preconditioner
-            search.heights(todo, search.point(todo, np.full((todo.size, 2), 0.5)), tight)
-            todo = todo[out[todo] == 0]
+        # the centre, without the recomputed preconditioner; what it leaves goes to the search below
+        search.heights(todo, search.point(todo, np.full((todo.size, 2), 0.5)), tight=False)
+        todo = todo[out[todo] == 0]
         if todo.size == 0:
             continue
         h2 = [search.heights(todo, search.point(todo, np.broadcast_to(f, (todo.size, 2))), tight=False) for f in grid]
-        h = np.sqrt(np.stack([0.5 * (e.lo + e.hi) for e in h2], axis=1))
         keep = out[todo] == 0
-        todo, h = todo[keep], h[keep]
-        _empty_pieces(geometry, search, todo, empty)
+        h2 = [Interval(e.lo[keep], e.hi[keep]) for e in h2]
+        todo = todo[keep]
+        h = np.sqrt(np.stack([0.5 * (e.lo + e.hi) for e in h2], axis=1))
+        _empty_pieces(geometry, search, todo, h2, empty)
         # bisect from the grid's lowest point to its highest, onto a height inside the box
         with np.errstate(invalid="ignore"):
             lo_at = np.argmin(np.where(np.isfinite(h), h, np.inf), axis=1)
@@ -160,25 +161,44 @@ def pair_sides(geometry: Geometry, joint_boxes: np.ndarray, models: FoldModels) 
     return FoldSides(out, empty)
 
 
-def _empty_pieces(geometry: Geometry, search: _Search, rows: np.ndarray, empty: np.ndarray) -> None:
-    """Prove pieces of the rows' boxes empty where h is monotone in both parameters (sets ``empty``)."""
-    k, i, j, R = search.k, search.i, search.j, search.R
+def _empty_pieces(geometry: Geometry, search: _Search, rows: np.ndarray, corners: list[Interval],
+                  empty: np.ndarray) -> None:
+    """Prove pieces of the rows' boxes empty where h is monotone in both parameters (sets ``empty``).
+
+    corners: the enclosures of h^2 at the :data:`GRID` corners (quick ones); where they do not
+    decide, the extreme corner is enclosed again with the recomputed preconditioner.
+    """
+    k, R = search.k, search.R
+    i, j = search.i, search.j
     sg = normal_signs(geometry, search.models.pose[rows]).astype(np.int64)
-    mono = (sg[:, i] != 0) & (sg[:, j] != 0) & (sg[:, k] != 0)
-    rows, sg = rows[mono], sg[mono]
-    if rows.size == 0:
+    at = np.flatnonzero((sg[:, i] != 0) & (sg[:, j] != 0) & (sg[:, k] != 0))
+    if at.size == 0:
         return
+    sg = sg[at]
     # dh/dr_a = -rho_a w_a / (rho_k w_k): the corner where h is largest takes the upper end where it rises
-    rise = np.stack([-sg[:, i] * sg[:, k] > 0, -sg[:, j] * sg[:, k] > 0], axis=1).astype(np.float64)
-    top = search.heights(rows, search.point(rows, rise))
-    low = search.heights(rows, search.point(rows, 1.0 - rise))
-    # h <= h(top corner) <= lo_k everywhere: nothing lies below the sheet (lo_k^2 rounded down)
-    lo_down = Interval.point(R[rows, k, 0]).sqr().lo
-    hi_up = Interval.point(R[rows, k, 1]).sqr().hi
+    rise = np.stack([-sg[:, i] * sg[:, k] > 0, -sg[:, j] * sg[:, k] > 0], axis=1)
+    top_at = 2 * rise[:, 0] + rise[:, 1]  # the index of corner (a, b) in GRID is 2 a + b
+    low_at = 3 - top_at
+    lo2 = np.stack([c.lo[at] for c in corners], axis=1)
+    hi2 = np.stack([c.hi[at] for c in corners], axis=1)
+    r = np.arange(at.size)
+    top = Interval(lo2[r, top_at], hi2[r, top_at])
+    low = Interval(lo2[r, low_at], hi2[r, low_at])
+    lo_down = Interval.point(R[rows[at], k, 0]).sqr().lo  # lo_k^2 rounded down
+    hi_up = Interval.point(R[rows[at], k, 1]).sqr().hi
+    with np.errstate(invalid="ignore"):
+        # the quick enclosure straddles the face: enclose the extreme corner tightly
+        redo_top = ~(top.hi <= lo_down) & (top.lo <= lo_down)
+        redo_low = ~(low.lo >= hi_up) & (low.hi >= hi_up)
+    for redo, box, corner in ((redo_top, top, rise), (redo_low, low, ~rise)):
+        if redo.any():
+            t = search.heights(rows[at[redo]], search.point(rows[at[redo]], corner[redo].astype(np.float64)))
+            box.lo[redo], box.hi[redo] = t.lo, t.hi
+    # h <= h(top corner) <= lo_k everywhere: nothing lies below the sheet; likewise above
     below_empty = top.hi <= lo_down
     above_empty = low.lo >= hi_up
-    empty[rows[below_empty]] = -1
-    empty[rows[above_empty & ~below_empty]] = 1
+    empty[rows[at[below_empty]]] = -1
+    empty[rows[at[above_empty & ~below_empty]]] = 1
 
 
 def side_of_tight(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray) -> np.ndarray:

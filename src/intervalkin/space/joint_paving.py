@@ -65,9 +65,9 @@ DEFAULT_JOINT_DEPTH = 6
 #: Further levels, only in the walls between cells of equal count.
 JOIN_LEVELS = 2
 #: Further levels in the undecided boxes that touch a face of the joint box (where thin cells hug the limits).
-FACE_LEVELS = 0
+FACE_LEVELS = 1
 #: Further levels in the undecided boxes that local models could not settle (with ``fold``).
-MODEL_LEVELS = 1
+MODEL_LEVELS = 2
 
 
 @dataclass(frozen=True, eq=False)
