@@ -75,16 +75,19 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=1000, help="random joint vectors checked by certified solves")
     ap.add_argument("--no-fold", action="store_true", help="no local models: the clear-box test alone")
     ap.add_argument("--model-levels", type=int, default=None, help="levels of local refinement (default: the library's)")
-    ap.add_argument("--face-levels", type=int, default=0, help="further levels for undecided boxes on the faces")
+    ap.add_argument("--face-levels", type=int, default=None,
+                    help="further levels for undecided boxes on the faces (default: the library's)")
     args = ap.parse_args()
     g = default_geometry() if args.geometry is None else load_geometry(args.geometry)
     print(f"{'depth':>5} {'boxes':>9} {'seconds':>8} {'peak MB':>8} {'certified':>9} {'regions':>7} "
           f"{'labelled':>8} {'agree':>6} {'wrong':>5}   cells (count: number)")
     first = None
     extra = {} if args.model_levels is None else {"model_levels": args.model_levels}
+    if args.face_levels is not None:
+        extra["face_levels"] = args.face_levels
     for depth in args.depths:
         t0 = time.perf_counter()
-        jp = pave_joint_space(g, depth, fold=not args.no_fold, face_levels=args.face_levels, **extra)
+        jp = pave_joint_space(g, depth, fold=not args.no_fold, **extra)
         dt = time.perf_counter() - t0
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
         n, labelled, agree, wrong = _agreement(g, jp, args.samples, seed=depth)

@@ -57,6 +57,7 @@ def shares_face(level: np.ndarray, ijk: np.ndarray, depth: int, periodic=(False,
     shift = depth - level
     nbits = depth + 1
     pairs = []
+    present = np.bincount(level, minlength=depth + 1) > 0  # a face of level L needs a box of level L
     for ax in range(3):
         o1, o2 = [a for a in range(3) if a != ax]
         plus_plane = (ijk[:, ax] + 1) << shift
@@ -70,7 +71,7 @@ def shares_face(level: np.ndarray, ijk: np.ndarray, depth: int, periodic=(False,
         mk = _face_keys(minus_plane, level, ijk[:, o1], ijk[:, o2], nbits)
         morder = np.argsort(mk, kind="stable")
         mk_sorted = mk[morder]
-        for L in range(depth + 1):
+        for L in np.flatnonzero(present[:depth + 1]):
             # minus faces of level >= L look for a plus face of level L containing them
             sel = np.flatnonzero(level >= L)
             d = level[sel] - L
