@@ -76,15 +76,11 @@ PARALLEL_JOINT_DEPTH = 6
 
 @dataclass(frozen=True)
 class ProgressEvent:
-    """One step of a running analysis, for a progress display.
-
-    ``kind`` is ``"start"``, ``"level"`` (one paving level done; ``level`` holds the
-    paver's statistics: level, depth, boxes, split, seconds), ``"fraction"`` (a
-    stage without levels says how much of its work is done: ``fraction`` in
-    [0, 1], ``detail`` names the work) or ``"done"``; ``stage`` names the stage
-    (the key of its time in :attr:`Analysis.timings`); ``seconds`` is the time
-    since the stage started.
-    """
+    """One step of a running analysis, for a progress display: ``kind`` is ``"start"``, ``"level"`` (one
+    paving level done; ``level`` holds the paver's statistics: level, depth, boxes, split, seconds),
+    ``"fraction"`` (a stage without levels says how much of its work is done: ``fraction`` in [0, 1],
+    ``detail`` names the work) or ``"done"``; ``stage`` names the stage (the key of its time in
+    :attr:`Analysis.timings`); ``seconds`` is the time since the stage started."""
 
     stage: str
     kind: str
@@ -325,8 +321,8 @@ def pave_joint_space(geometry: Geometry | None = None, singular_depth: int = DEF
 
 
 def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progress: ProgressCallback | None = None,
-            refine_to: int | None = None,
-            while_waiting: Callable[[RegionAnalysis, JointPaving], None] | None = None) -> Analysis:
+            refine_to: int | None = None, while_waiting: Callable[[RegionAnalysis, JointPaving], None] | None = None
+            ) -> Analysis:
     """Run the chain geometry -> singular layer -> joint cells -> regions -> uniqueness domains.
 
     Parameters
@@ -340,9 +336,8 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
         certified box), pave the regions one level deeper, up to this depth.  The paver
         splits only undecided boxes, so a deeper level refines near the characteristic
         surfaces, the singular layer and the joint limits only.
-    while_waiting : work that needs the regions and the joint-space enclosure but not the
-        joint cells (the paper run's trajectories), called with both while the direct joint
-        paving is still running in its second process (the main process would idle).
+    while_waiting : work needing the regions and the joint enclosure, not the joint cells (the paper
+        run's trajectories), called with both while the joint paving runs in its second process.
 
     Raises :class:`~intervalkin.core.errors.InputError` on a bad depth and
     :class:`~intervalkin.core.errors.ResourceError` when the run would not fit in memory.
@@ -371,7 +366,7 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
             topology = prove_aspects(geometry)
         if while_waiting is not None:
             with stages.stage("work beside the joint paving (trajectories)"):
-                while_waiting(regions, joint)
+                while_waiting(regions, joint)  # the main process would idle while the joint paving runs
         if future is not None:
             with stages.stage(name + ", in a second process: waiting for it"):
                 cells = future.result()

@@ -29,7 +29,7 @@ def _inferred_points(geometry, jp, sig, n, rng):
     known = sig[:, :, 0] >= 0
     boxes = np.flatnonzero((known & (pc < 0)).any(axis=1))
     out = []
-    for t in rng.permutation(boxes)[:4 * n]:
+    for t in rng.permutation(boxes)[:12 * n]:
         b = jp.pieces.box[t]
         lo, hi = jp.paving.lo[b], jp.paving.hi[b]
         q = lo + rng.random((12, 3)) * (hi - lo)
