@@ -55,7 +55,7 @@ from intervalkin.space.basic_region import (
     label_pose,
 )
 from intervalkin.space.joint_cells import regions_from_cells
-from intervalkin.space.joint_paving import FACE_LEVELS, JOIN_LEVELS, MODEL_LEVELS, JointSpacePaving
+from intervalkin.space.joint_paving import DEFAULT_JOINT_DEPTH, FACE_LEVELS, JOIN_LEVELS, MODEL_LEVELS, JointSpacePaving
 from intervalkin.space.joint_paving import pave_joint_space as pave_joint_cells
 from intervalkin.space.joint_space import JointPaving, joint_paving
 from intervalkin.space.pose_label import PoseLabel
@@ -328,16 +328,13 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     Parameters
     ----------
     geometry : the manipulator; the paper's (Wenger & Chablat 1997) when None.
-    depth : octree depth of the regions paving, 3..MAX_CHAIN_DEPTH (see :func:`chain_depths`
-        for the depths of the other stages).
-    progress : called with a :class:`ProgressEvent` at the start and end of each stage and
-        after each paving level.
-    refine_to : while Proposition 1 is not seen in full (a sheet of a counted cell holds no
-        certified box), pave the regions one level deeper, up to this depth.  The paver
-        splits only undecided boxes, so a deeper level refines near the characteristic
-        surfaces, the singular layer and the joint limits only.
-    while_waiting : work needing the regions and the joint enclosure, not the joint cells (the paper
-        run's trajectories), called with both while the joint paving runs in its second process.
+    depth : octree depth of the regions paving, 3..MAX_CHAIN_DEPTH (:func:`chain_depths` gives the other
+        stages'; below the default the joint paving is a preview: one level of local refinement, no face level).
+    progress : called with a :class:`ProgressEvent` at the start and end of each stage and after each level.
+    refine_to : while Proposition 1 is not seen in full (a sheet of a counted cell holds no certified box),
+        pave the regions one level deeper, up to this depth (only undecided boxes are split).
+    while_waiting : work needing the regions and the joint enclosure, not the joint cells (the paper run's
+        trajectories), done while the joint paving runs in its second process.
 
     Raises :class:`~intervalkin.core.errors.InputError` on a bad depth and
     :class:`~intervalkin.core.errors.ResourceError` when the run would not fit in memory.
@@ -347,8 +344,10 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     dw, ds, dj = chain_depths(depth)
     stages = _Stages(progress)
     joint = _joint_space(geometry, ds, dj, stages)
-    name = (f"joint space paved directly (depth {dj - 1}, local models, {MODEL_LEVELS} levels of local refinement, "
-            f"{FACE_LEVELS} on the faces, {JOIN_LEVELS} join levels)")
+    full = dj - 1 >= DEFAULT_JOINT_DEPTH  # below the default depth, a preview: one level of local refinement
+    levels = {"model_levels": MODEL_LEVELS if full else 1, "face_levels": FACE_LEVELS if full else 0}
+    name = (f"joint space paved directly (depth {dj - 1}, local models, {levels['model_levels']} + "
+            f"{levels['face_levels']} levels of local and face refinement, {JOIN_LEVELS} join levels)")
     with contextlib.ExitStack() as side:
         future = None
         daemonic = multiprocessing.current_process().daemon
@@ -356,10 +355,10 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
             # the two pavings are independent: the joint one runs in a second process beside the regions
             # (not from a daemonic process, such as a Dask worker, which may not have children: in-process there)
             pool = side.enter_context(ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")))
-            future = pool.submit(pave_joint_cells, geometry, dj - 1, JOIN_LEVELS)
+            future = pool.submit(pave_joint_cells, geometry, dj - 1, JOIN_LEVELS, **levels)
         else:
-            with stages.stage(name) as levels:
-                cells = pave_joint_cells(geometry, dj - 1, JOIN_LEVELS, progress=levels)
+            with stages.stage(name) as report:
+                cells = pave_joint_cells(geometry, dj - 1, JOIN_LEVELS, progress=report, **levels)
         with stages.stage(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})") as levels:
             regions = analyse_regions(geometry, joint, dw, progress=levels)
         with stages.stage("aspects: covers proving each sign of det A connected"):
