@@ -170,11 +170,11 @@ class JointSpacePaving:
         piece by the side test and takes that piece's signature (from its cell, or inferred).
         """
         q = np.asarray(rho, dtype=np.float64)
-        out = np.full((len(q), 3), -1, dtype=np.int64)
-        every = {c.id: c.signature for c in self.cells + self.fragments}
-        cid = self.cell_of(q, geometry)
-        for i in np.flatnonzero(cid >= 0):
-            out[i] = every[int(cid[i])]
+        every = self.cells + self.fragments
+        table = np.full((len(every) + 1, 3), -1, dtype=np.int64)  # row -1: no cell
+        for c in every:
+            table[c.id] = c.signature
+        out = table[self.cell_of(q, geometry)]
         if self.pieces is None or not len(self.pieces) or self.piece_signatures is None:
             return out
         leaf = self.paving.locate_boxes(np.stack([q, q], axis=-1))
