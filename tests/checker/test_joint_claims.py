@@ -30,12 +30,12 @@ from intervalkin.checker.joint_torus import torus_search
 from intervalkin.checker.model import ArbModel
 from intervalkin.core.exact import exact_text
 from intervalkin.core.geometry import load_geometry
-from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
+from intervalkin.kinematics.formulas import approx_inverse_kinematics
 from intervalkin.paving.labels import Label
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.fold_model import side_of
 from tests.conftest import DATA
-from tests.solve.shared import box_across_singular_image, concurrent_legs_box
+from tests.solve.shared import box_across_singular_image, concurrent_legs_box, first_det_change
 
 MODELS = "joint_fold_model.json"
 
@@ -349,11 +349,10 @@ def test_boxes_around_singular_images_are_never_clear(x, phi, width):
 
     g = default_geometry()
     ys = np.linspace(-25.0, 25.0, 401)
-    det = approx_det_a(g, np.stack([np.full_like(ys, x), ys, np.full_like(ys, phi)], axis=1))
-    change = np.flatnonzero(np.sign(det[:-1]) * np.sign(det[1:]) < 0)
-    if change.size == 0:
+    c = first_det_change(g, x, phi, ys)
+    if c is None:
         return
-    a, b = ys[change[0]], ys[change[0] + 1]
+    a, b = ys[c], ys[c + 1]
     ctx.prec = 128
     model = ArbModel(g)
     da, db = model.det(arb(x), arb(a), arb(phi)), model.det(arb(x), arb(b), arb(phi))

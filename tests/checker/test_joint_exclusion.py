@@ -18,7 +18,7 @@ from intervalkin.checker.joint_exclusion import excluded
 from intervalkin.checker.joint_torus import torus_search
 from intervalkin.checker.model import ArbModel
 from intervalkin.core.geometry import default_geometry
-from intervalkin.kinematics.formulas import approx_det_a
+from tests.solve.shared import first_det_change
 
 
 @settings(max_examples=30, deadline=None)
@@ -29,13 +29,12 @@ def test_exclusion_never_discards_a_cell_holding_a_singular_pose(x, phi, width):
     the same box with the joint box moved off those joint vectors is (the test can fail both ways)."""
     g = default_geometry()
     ys = np.linspace(-25.0, 25.0, 4001)
-    det = approx_det_a(g, np.stack([np.full_like(ys, x), ys, np.full_like(ys, phi)], axis=1))
-    change = np.flatnonzero(np.sign(det[:-1]) * np.sign(det[1:]) < 0)
-    if change.size == 0:
+    c = first_det_change(g, x, phi, ys)
+    if c is None:
         return
     ctx.prec = 128
     model = ArbModel(g)
-    y0 = ys[change[0]]
+    y0 = ys[c]
     a, b = y0 - width, y0 + width
     while True:  # shrink the bracket towards the sign change of the float samples, keeping it proved
         da, db = model.det(arb(x), arb(a), arb(phi)), model.det(arb(x), arb(b), arb(phi))

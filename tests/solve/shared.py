@@ -72,3 +72,13 @@ def det_zeros_along_y(geometry, x: np.ndarray, phi: np.ndarray, ys: np.ndarray):
         a, b, da = np.where(same, m, a), np.where(same, b, m), np.where(same, dm, da)
     return line, a, b
 
+
+
+def first_det_change(geometry, x: float, phi: float, ys: np.ndarray) -> int | None:
+    """Index c of the first float sign change of det A between ys[c] and ys[c + 1] on the line (x, ., phi),
+    None when det A keeps one sign there.  Not certified: it only chooses where a test brackets in arb."""
+    from intervalkin.kinematics.formulas import approx_det_a
+
+    det = approx_det_a(geometry, np.stack([np.full_like(ys, x), ys, np.full_like(ys, phi)], axis=1))
+    change = np.flatnonzero(np.sign(det[:-1]) * np.sign(det[1:]) < 0)
+    return int(change[0]) if change.size else None
