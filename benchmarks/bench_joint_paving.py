@@ -1,9 +1,11 @@
 """Benchmark of the direct joint-space paving (a script, not a test).
 
     python benchmarks/bench_joint_paving.py [--depths 6 7] [--geometry FILE] [--samples 2000] [--no-fold]
-        [--model-levels 1] [--face-levels 3]
+        [--model-levels 1] [--face-levels 3] [--workers 1]
 
-Per depth: boxes, wall time, peak memory (resident set of this process), the share of
+Per depth: boxes, wall time, peak memory (resident set of this process; and, sampled
+every 0.2 s, the largest sum over this process and its workers of the memory each holds
+alone, psutil's USS: what the run costs the machine), the share of
 the joint box's volume in boxes certified off g(S), the cells (count: number), the
 basic regions they imply (the sum of the cells' counts, Theorem 1), and the agreement
 of the paving with independent certified solves at random joint vectors: labelled
@@ -22,15 +24,43 @@ from __future__ import annotations
 
 import argparse
 import resource
+import threading
 import time
 from collections import Counter
 from fractions import Fraction
 
 import numpy as np
+import psutil
 
 from intervalkin.core.geometry import default_geometry, load_geometry
 from intervalkin.solve.dkp import solve
 from intervalkin.space.joint_paving import DEFAULT_JOINT_DEPTH, joint_domain, pave_joint_space
+
+
+class _MemoryWatch:
+    """The largest sum, sampled, of the unique set sizes (USS) of this process and its children."""
+
+    def __init__(self, every: float = 0.2):
+        self.peak, self.every, self._stop = 0, every, threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        me = psutil.Process()
+        while not self._stop.is_set():
+            total = 0
+            for p in [me] + me.children(recursive=True):
+                try:
+                    total += p.memory_full_info().uss
+                except psutil.Error:  # a worker that just ended
+                    pass
+            self.peak = max(self.peak, total)
+            self._stop.wait(self.every)
+
+    def stop(self) -> int:
+        self._stop.set()
+        self._thread.join()
+        return self.peak
 
 
 def _agreement(geometry, jp, samples: int, seed: int) -> tuple[int, int, int, int]:
@@ -77,23 +107,28 @@ def main() -> None:
     ap.add_argument("--model-levels", type=int, default=None, help="levels of local refinement (default: the library's)")
     ap.add_argument("--face-levels", type=int, default=None,
                     help="further levels for undecided boxes on the faces (default: the library's)")
+    ap.add_argument("--workers", type=int, default=None, help="processes (default: the library's, two on 2 cores)")
     args = ap.parse_args()
     g = default_geometry() if args.geometry is None else load_geometry(args.geometry)
-    print(f"{'depth':>5} {'boxes':>9} {'seconds':>8} {'peak MB':>8} {'certified':>9} {'regions':>7} "
+    print(f"{'depth':>5} {'boxes':>9} {'seconds':>8} {'peak MB':>8} {'all MB':>7} {'certified':>9} {'regions':>7} "
           f"{'labelled':>8} {'agree':>6} {'wrong':>5}   cells (count: number)")
     first = None
     extra = {} if args.model_levels is None else {"model_levels": args.model_levels}
     if args.face_levels is not None:
         extra["face_levels"] = args.face_levels
+    if args.workers is not None:
+        extra["workers"] = args.workers
     for depth in args.depths:
+        watch = _MemoryWatch()
         t0 = time.perf_counter()
         jp = pave_joint_space(g, depth, fold=not args.no_fold, **extra)
         dt = time.perf_counter() - t0
+        every = watch.stop() / 2**20
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
         n, labelled, agree, wrong = _agreement(g, jp, args.samples, seed=depth)
         kinds = Counter(c.count for c in jp.cells)
         cells = ", ".join(f"{k}: {kinds[k]}" for k in sorted(kinds))
-        print(f"{depth:>5} {len(jp.paving):>9} {dt:>8.1f} {peak:>8.0f} {100 * jp.certified_share():>8.1f}% "
+        print(f"{depth:>5} {len(jp.paving):>9} {dt:>8.1f} {peak:>8.0f} {every:>7.0f} {100 * jp.certified_share():>8.1f}% "
               f"{sum(c.count for c in jp.cells):>7} {100 * labelled / n:>7.1f}% {100 * agree / n:>5.1f}% {wrong:>5}   {cells}",
               flush=True)
         if jp.fold_stats:
@@ -110,7 +145,8 @@ def main() -> None:
             first = jp
         else:
             print("       " + _compare(g, first, jp), flush=True)
-    print("peak MB is the process's maximum resident set so far (it includes the earlier depths).")
+    print("peak MB is the process's maximum resident set so far (it includes the earlier depths); all MB the "
+          "largest sampled sum of the memory held alone by this process and its workers during that depth's paving.")
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ from typing import Callable
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Workers, owned_rows
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving, box_bounds, split_boxes
 from intervalkin.solve.joint_box import initial_cells, live_cells
@@ -26,6 +27,8 @@ __all__ = ["adaptive_leaves", "refine_leaves", "leaves_to_paving", "Leaves"]
 
 #: (level, ijk, lo, hi, clear, owner, cells)
 Leaves = tuple[np.ndarray, ...]
+#: Leaves split together by :func:`refine_leaves` (their children, 8 per leaf, are tested together).
+_BATCH = 16384
 
 
 @dataclass
@@ -58,10 +61,18 @@ def _children(front: _Front, cut: np.ndarray) -> _Front:
     return _Front(level, ijk, owner, cells)
 
 
-def _test(geometry: Geometry, domain: np.ndarray, front: _Front) -> tuple[np.ndarray, np.ndarray, np.ndarray, _Front]:
-    """Test a front: (lo, hi, clear mask, the front with its cells updated)."""
+def _test(geometry: Geometry, domain: np.ndarray, front: _Front,
+          workers: Workers | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, _Front]:
+    """Test a front: (lo, hi, clear mask, the front with its cells updated); in parts on the workers."""
     lo, hi = box_bounds(domain, front.level, front.ijk)
-    owner, cells = live_cells(geometry, np.stack([lo, hi], axis=-1), front.owner, front.cells)
+    boxes = np.stack([lo, hi], axis=-1)
+    workers = Workers(1) if workers is None else workers
+    parts = workers.parts(len(boxes))
+    calls = [(geometry, boxes[a:b], front.owner[ra:rb] - a, front.cells[ra:rb])
+             for (a, b), (ra, rb) in zip(parts, owned_rows(front.owner, parts))]
+    found = workers.run(live_cells, calls)
+    owner = np.concatenate([o + a for (o, _), (a, _) in zip(found, parts)])
+    cells = np.concatenate([c for _, c in found])
     clear = np.bincount(owner, minlength=len(front.level)) == 0
     return lo, hi, clear, _Front(front.level, front.ijk, owner, cells)
 
@@ -88,8 +99,8 @@ class _Leaves:
         return (*cols, owner, cells)
 
 
-def adaptive_leaves(geometry: Geometry, domain: np.ndarray, depth: int,
-              progress: Callable[[dict], None] | None) -> tuple[_Leaves, list[dict]]:
+def adaptive_leaves(geometry: Geometry, domain: np.ndarray, depth: int, progress: Callable[[dict], None] | None,
+                    workers: Workers | None = None) -> tuple[_Leaves, list[dict]]:
     """Bisect the joint box, keeping clear boxes and splitting the others, down to ``depth``."""
     owner, cells = initial_cells(1)
     front = _Front(np.zeros(1, dtype=np.int64), np.zeros((1, 3), dtype=np.int64), owner, cells)
@@ -98,7 +109,7 @@ def adaptive_leaves(geometry: Geometry, domain: np.ndarray, depth: int,
     dom_vol = float(np.prod(domain[:, 1] - domain[:, 0]))
     for lev in range(depth + 1):
         t0 = time.perf_counter()
-        lo, hi, clear, front = _test(geometry, domain, front)
+        lo, hi, clear, front = _test(geometry, domain, front, workers)
         cut = ~clear if lev < depth else np.zeros(len(clear), dtype=bool)
         leaves.add(front, lo, hi, clear, ~cut)
         stats.append({"stage": "joint paving", "level": lev, "depth": depth, "boxes": int(len(clear)),
@@ -120,18 +131,25 @@ def leaves_to_paving(domain: np.ndarray, leaves: tuple[np.ndarray, ...], stats: 
                   labels={"clear": lab}, stats=stats)
 
 
-def refine_leaves(geometry: Geometry, domain: np.ndarray, leaves: tuple[np.ndarray, ...], wall: np.ndarray):
+def refine_leaves(geometry: Geometry, domain: np.ndarray, leaves: tuple[np.ndarray, ...], wall: np.ndarray,
+                  workers: Workers | None = None):
     """Split the wall leaves once and test their children (inheriting the walls' live cells)."""
     level, ijk, lo, hi, clear, owner, cells = leaves
     sel = wall[owner]
     rank = np.cumsum(wall) - 1
-    front = _Front(level[wall], ijk[wall], rank[owner[sel]], cells[sel])
-    front = _children(front, np.ones(len(front.level), dtype=bool))
-    clo, chi, cclear, front = _test(geometry, domain, front)
+    parents = _Front(level[wall], ijk[wall], rank[owner[sel]], cells[sel])
     out = _Leaves()
     keep = ~wall
     pos = np.full(len(keep), -1)
     pos[keep] = np.arange(np.count_nonzero(keep))
     out.parts.append((level[keep], ijk[keep], lo[keep], hi[keep], clear[keep], pos[owner[~sel]], cells[~sel]))
-    out.add(front, clo, chi, cclear, np.ones(len(cclear), dtype=bool))
+    # the children inherit their parents' cells eightfold: made and tested a batch of parents at a time, so
+    # only one batch's inherited cells are in memory (each box's test is its own: the same leaves, in order)
+    n = len(parents.level)
+    batches = [(a, min(a + _BATCH, n)) for a in range(0, n, _BATCH)]
+    for (a, b), (ra, rb) in zip(batches, owned_rows(parents.owner, batches)):
+        batch = _Front(parents.level[a:b], parents.ijk[a:b], parents.owner[ra:rb] - a, parents.cells[ra:rb])
+        front = _children(batch, np.ones(b - a, dtype=bool))
+        clo, chi, cclear, front = _test(geometry, domain, front, workers)
+        out.add(front, clo, chi, cclear, np.ones(len(cclear), dtype=bool))
     return out.merge()

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Workers, owned_rows
 from intervalkin.solve.fold_model import FoldModels
 from intervalkin.solve.local_model import local_models
 from intervalkin.space.joint_pieces import FoldPieces, fold_pieces
@@ -37,8 +38,9 @@ def leaf_keys(level: np.ndarray, ijk: np.ndarray) -> np.ndarray:
 class ModelStore:
     """Local models of undecided leaves, keyed by leaf; void leaves are turned clear."""
 
-    def __init__(self, geometry: Geometry):
+    def __init__(self, geometry: Geometry, workers: Workers | None = None):
         self.geometry = geometry
+        self.workers = Workers(1) if workers is None else workers
         self.keys = np.zeros(0, dtype=np.int64)
         self.models: FoldModels | None = None
         #: keys of the leaves proved clear by exclusion so far, and their volume
@@ -58,7 +60,7 @@ class ModelStore:
         pos[fresh] = np.arange(fresh.size)
         sel = pos[owner] >= 0
         boxes = np.stack([lo[fresh], hi[fresh]], axis=-1)
-        m = local_models(self.geometry, boxes, pos[owner[sel]], cells[sel])
+        m = self._local_models(boxes, pos[owner[sel]], cells[sel])
         self.models = m if self.models is None else self.models.concat(m)
         self.keys = np.concatenate([self.keys, keys[new]])
         gone = fresh[m.void]
@@ -70,6 +72,17 @@ class ModelStore:
         clear[gone] = True
         keep = ~np.isin(owner, gone)
         return level, ijk, lo, hi, clear, owner[keep], cells[keep]
+
+    def _local_models(self, boxes: np.ndarray, owner: np.ndarray, cells: np.ndarray) -> FoldModels:
+        """:func:`local_models` of the boxes, in contiguous parts on the workers (each box is modelled on its own)."""
+        parts = self.workers.parts(len(boxes))
+        calls = [(self.geometry, boxes[a:b], owner[ra:rb] - a, cells[ra:rb])
+                 for (a, b), (ra, rb) in zip(parts, owned_rows(owner, parts))]
+        out = self.workers.run(local_models, calls)
+        models = out[0]
+        for m in out[1:]:
+            models = models.concat(m)
+        return models
 
     def voided(self, level: np.ndarray, ijk: np.ndarray) -> np.ndarray:
         """(n,) bool: which of these leaves were proved clear by exclusion."""
@@ -101,4 +114,4 @@ class ModelStore:
         if box.size == 0:
             return None
         level, ijk, lo, hi, clear = leaves[:5]
-        return fold_pieces(self.geometry, lo, hi, clear, face_edges, box, self.models.take(row[box]))
+        return fold_pieces(self.geometry, lo, hi, clear, face_edges, box, self.models.take(row[box]), self.workers)

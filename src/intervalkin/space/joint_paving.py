@@ -48,6 +48,7 @@ import numpy as np
 from intervalkin.core.errors import InputError
 from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Workers, default_workers
 from intervalkin.paving.budget import check_depth
 from intervalkin.paving.tree import Paving
 from intervalkin.solve.fold_model import side_of
@@ -224,7 +225,8 @@ def joint_domain(geometry: Geometry) -> np.ndarray:
 
 def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_levels: int = JOIN_LEVELS,
                      progress: Callable[[dict], None] | None = None, fold: bool = True,
-                     face_levels: int = FACE_LEVELS, model_levels: int = MODEL_LEVELS) -> JointSpacePaving:
+                     face_levels: int = FACE_LEVELS, model_levels: int = MODEL_LEVELS,
+                     workers: int | None = None) -> JointSpacePaving:
     """Pave the joint box to ``depth`` with the clear-box test, join cells across walls, and count them.
 
     Parameters
@@ -241,6 +243,9 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     face_levels : further levels in the undecided leaves that touch a face of the joint box.
     model_levels : with ``fold``, further levels in the leaves left without a model (split,
         re-tested, modelled again), the last step of the local refinement.
+    workers : processes (default: two on a machine with two cores or more, see
+        :func:`intervalkin.core.workers.default_workers`); large steps are cut into parts
+        computed at once, and the paving is the same bit for bit whatever the number.
 
     Cost: the undecided boxes lie along the 2-D surface g(S), so their number grows
     like 4**depth; each cell costs one certified solve.
@@ -249,10 +254,21 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     for name, v in (("join_levels", join_levels), ("face_levels", face_levels), ("model_levels", model_levels)):
         if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 8:
             raise InputError(f"{name}: expected an integer in 0..8, got {v!r}")
+    count = default_workers() if workers is None else workers
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= 64:
+        raise InputError(f"workers: expected an integer in 1..64, got {workers!r}")
+    with Workers(count) as pool:
+        if depth >= DEFAULT_JOINT_DEPTH:  # large enough to use them: started while this process is small
+            pool.start()
+        return _pave(geometry, depth, join_levels, progress, fold, face_levels, model_levels, pool)
+
+
+def _pave(geometry: Geometry, depth: int, join_levels: int, progress, fold: bool, face_levels: int,
+          model_levels: int, pool: Workers) -> JointSpacePaving:
     domain = joint_domain(geometry)
-    found_leaves, stats = adaptive_leaves(geometry, domain, depth, progress)
+    found_leaves, stats = adaptive_leaves(geometry, domain, depth, progress, pool)
     leaves = found_leaves.merge()
-    store = ModelStore(geometry) if fold else None
+    store = ModelStore(geometry, pool) if fold else None
     settle = (lambda lv: store.settle(lv)) if store is not None else (lambda lv: lv)
     leaves = _timed(progress, stats, store, "local models", depth, lambda: settle(leaves), leaves)
     for extra in range(model_levels if store is not None else 0):
@@ -260,7 +276,7 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         if not np.any(wall):
             break
         leaves = _timed(progress, stats, store, "local refinement", depth + extra + 1,
-                        lambda: settle(refine_leaves(geometry, domain, leaves, wall)), leaves, wall)
+                        lambda: settle(refine_leaves(geometry, domain, leaves, wall, pool)), leaves, wall)
     for extra in range(face_levels):
         # thin cells hug the faces rho_i = rho_min / rho_max: refine the undecided leaves that touch one
         level, lo, hi, clear = leaves[0], leaves[2], leaves[3], leaves[4]
@@ -269,7 +285,7 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         if not np.any(wall):
             break
         leaves = _timed(progress, stats, store, "faces", depth + extra + 1,
-                        lambda: settle(refine_leaves(geometry, domain, leaves, wall)), leaves, wall)
+                        lambda: settle(refine_leaves(geometry, domain, leaves, wall, pool)), leaves, wall)
     fine = top = int(leaves[0].max())
     cells = CellSolver(geometry)
 
@@ -287,7 +303,7 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         if not np.any(wall):
             break
         leaves = _timed(progress, stats, store, "joins", depth + extra + 1,
-                        lambda: settle(refine_leaves(geometry, domain, leaves, wall)), leaves, wall)
+                        lambda: settle(refine_leaves(geometry, domain, leaves, wall, pool)), leaves, wall)
         fine = max(fine, int(leaves[0].max()))
     pieces, piece_cell, fold_stats, signatures = None, np.zeros(0, dtype=np.int32), {}, None
     if store is not None:

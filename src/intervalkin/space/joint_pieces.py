@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Workers
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
@@ -74,14 +75,32 @@ def _face_points(lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: np.ndarray) -
     return pts
 
 
+def _sides(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray,
+           workers: Workers) -> np.ndarray:
+    """:func:`side_of` in parts on the workers; each part ships only the models its points use."""
+    parts = workers.parts(len(box))
+    if len(parts) == 1:
+        return side_of(geometry, models, box, points)
+    order = np.argsort(box, kind="stable")
+    calls = []
+    for a, b in parts:
+        uniq, inv = np.unique(box[order[a:b]], return_inverse=True)
+        calls.append((geometry, models.take(uniq), inv, points[order[a:b]]))
+    out = np.empty(len(box), dtype=np.int8)
+    for (a, b), side in zip(parts, workers.run(side_of, calls)):
+        out[order[a:b]] = side
+    return out
+
+
 def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.ndarray, face_edges: np.ndarray,
-                box: np.ndarray, models: FoldModels) -> FoldPieces:
+                box: np.ndarray, models: FoldModels, workers: Workers | None = None) -> FoldPieces:
     """The piece graph edges and witnesses of fold boxes ``box`` (their ``models``) in a paving.
 
     lo, hi : (n, 3) leaves; clear : (n,) bool, proved off g(S); face_edges : (2, e)
     face-adjacent leaf pairs.  Certified: every edge joins two connected sets off g(S)
     that share a point; every witness lies in its piece.
     """
+    workers = Workers(1) if workers is None else workers
     n = len(lo)
     m = len(box)
     model_of = np.full(n, -1, dtype=np.int64)
@@ -103,7 +122,7 @@ def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.nd
     for c, f in enumerate(INNER_FRACTIONS):
         inner[rows, c, k] = lo[box, k] + f * (hi[box, k] - lo[box, k])
     t_in = np.repeat(rows, len(INNER_FRACTIONS))
-    side_in = side_of(geometry, models, t_in, inner.reshape(-1, 3))
+    side_in = _sides(geometry, models, t_in, inner.reshape(-1, 3), workers)
     good = side_in != 0
     covered = np.zeros(2 * m, dtype=bool)
     covered[2 * t_in[good] + (side_in[good] > 0)] = True
@@ -122,7 +141,7 @@ def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.nd
             is_model &= placed[0] | ~both_covered[np.maximum(t, 0)]
             ok[(t >= 0) & ~is_model] = False
         if is_model.any():
-            side = side_of(geometry, models, t[is_model], q[is_model])
+            side = _sides(geometry, models, t[is_model], q[is_model], workers)
             nd[is_model] = n + 2 * t[is_model] + (side > 0)
             ok[is_model] = side != 0
         node.append(nd)

@@ -1,0 +1,105 @@
+"""Worker processes for vectorised work that splits into independent parts.
+
+The joint paving spends most of its time in kernels that treat each box (or each
+point) on its own: the clear-box search, the local models, the side tests.  Cut
+into parts, such work gives the same arrays whichever process computes each part,
+so a second core can take a part while this process computes another, and the
+answer is bit-for-bit the one of a single process.
+
+:class:`Workers` owns the extra processes.  They are started on the first call
+large enough to pay for them (forked where the platform can: no re-import, and
+no need for a ``__main__`` guard in the caller's script), and stopped when the
+``with`` block ends.  With one
+worker, or for small calls, everything runs here, in order.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+__all__ = ["Workers", "default_workers", "owned_rows", "MIN_PARALLEL_ITEMS"]
+
+#: Calls on fewer items than this run in this process (a part must outweigh the cost of shipping it).
+MIN_PARALLEL_ITEMS = 20000
+
+
+def default_workers() -> int:
+    """Processes to use by default: two when the machine has two cores or more, one inside a daemonic
+    process (such as a Dask worker, which may not start children)."""
+    if multiprocessing.current_process().daemon:
+        return 1
+    return 2 if (os.cpu_count() or 1) > 1 else 1
+
+
+def owned_rows(owner, parts: Sequence[tuple[int, int]]) -> list[tuple[int, int]]:
+    """For rows sorted by ``owner`` (an int array), the row range of each owner range [start, stop)."""
+    owner = np.asarray(owner)
+    return [(int(np.searchsorted(owner, a, "left")), int(np.searchsorted(owner, b, "left"))) for a, b in parts]
+
+
+def _context():
+    # fork where there is one: a spawned interpreter would re-run the caller's main script, which breaks
+    # every script without a __main__ guard; the forked worker shares this process's pages until it writes
+    methods = multiprocessing.get_all_start_methods()
+    return multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+
+
+class Workers:
+    """Up to ``count`` processes: this one and ``count - 1`` started on demand.
+
+    Use as a context manager; :meth:`parts` cuts n items into contiguous ranges and
+    :meth:`run` computes one call per range, the first here and the others in the
+    workers, and returns the results in order.  ``fn`` must be a module-level function
+    and its arguments picklable.
+    """
+
+    def __init__(self, count: int = 1, min_items: int | None = None):
+        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+            raise ValueError(f"workers: expected a positive integer, got {count!r}")
+        self.count = count
+        self.min_items = min_items
+        self._pool: ProcessPoolExecutor | None = None
+
+    def __enter__(self) -> "Workers":
+        return self
+
+    def start(self) -> "Workers":
+        """Start the workers now (a forked worker then shares only what this process holds so far)."""
+        if self.count > 1 and self._pool is None:
+            self._pool = ProcessPoolExecutor(max_workers=self.count - 1, mp_context=_context())
+            for f in [self._pool.submit(os.getpid) for _ in range(self.count - 1)]:
+                f.result()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+
+    def parts(self, n: int) -> list[tuple[int, int]]:
+        """Contiguous ranges [start, stop) covering range(n): one per process, or one when n is small."""
+        k = self.count if n >= (MIN_PARALLEL_ITEMS if self.min_items is None else self.min_items) else 1
+        cuts = [n * i // k for i in range(k + 1)]
+        return [(cuts[i], cuts[i + 1]) for i in range(k)]
+
+    def run(self, fn: Callable[..., Any], calls: Sequence[tuple]) -> list:
+        """[fn(*args) for args in calls], the first call here and the others in the workers, concurrently."""
+        if len(calls) <= 1 or self.count == 1:
+            return [fn(*args) for args in calls]
+        self.start()
+        futures = [self._pool.submit(fn, *args) for args in calls[1:]]
+        try:
+            first = fn(*calls[0])
+            return [first] + [f.result() for f in futures]
+        except BaseException:
+            for f in futures:
+                f.cancel()
+            raise

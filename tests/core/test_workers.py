@@ -1,0 +1,62 @@
+"""Work cut into parts on worker processes gives the answer of one process, in order."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from intervalkin.core import workers as workers_module
+from intervalkin.core.geometry import default_geometry
+from intervalkin.core.workers import Workers, owned_rows
+from intervalkin.space.joint_paving import pave_joint_space
+
+
+def _square_and_pid(x: np.ndarray) -> tuple[np.ndarray, int]:
+    return x * x, os.getpid()
+
+
+def test_parts_cover_the_items_once():
+    w = Workers(3, min_items=10)
+    for n in (0, 1, 9, 10, 11, 1000):
+        parts = w.parts(n)
+        covered = np.concatenate([np.arange(a, b) for a, b in parts]) if parts else np.zeros(0)
+        assert np.array_equal(covered, np.arange(n))
+        assert len(parts) == (3 if n >= 10 else 1)
+
+
+def test_owned_rows_follow_the_owners():
+    owner = np.array([0, 0, 1, 3, 3, 3, 4])
+    assert owned_rows(owner, [(0, 2), (2, 4), (4, 5)]) == [(0, 3), (3, 6), (6, 7)]
+
+
+def test_run_keeps_the_order_and_uses_a_second_process():
+    x = np.arange(40000, dtype=np.float64)
+    with Workers(2) as w:
+        parts = w.parts(len(x))
+        out = w.run(_square_and_pid, [(x[a:b],) for a, b in parts])
+    assert len(out) == 2
+    assert np.array_equal(np.concatenate([o for o, _ in out]), x * x)
+    assert out[0][1] == os.getpid() and out[1][1] != os.getpid()
+
+
+def test_bad_worker_counts_are_refused():
+    for bad in (0, -1, True, 1.5):
+        with pytest.raises(ValueError):
+            Workers(bad)
+
+
+def test_joint_paving_is_the_same_with_two_workers(monkeypatch):
+    # small parts, so a depth-4 paving really is cut: every column must be identical, bit for bit
+    monkeypatch.setattr(workers_module, "MIN_PARALLEL_ITEMS", 64)
+    g = default_geometry()
+    one = pave_joint_space(g, 4, model_levels=1, face_levels=0, workers=1)
+    two = pave_joint_space(g, 4, model_levels=1, face_levels=0, workers=2)
+    a, b = one.columns(), two.columns()
+    assert a.keys() == b.keys()
+    for k in a:
+        assert np.array_equal(a[k], b[k], equal_nan=True), k
+    assert [c.signature for c in one.cells] == [c.signature for c in two.cells]
+    assert np.array_equal(one.pieces.edges, two.pieces.edges)
+    assert np.array_equal(one.piece_signatures.signature, two.piece_signatures.signature)
