@@ -31,6 +31,10 @@ their box has one: the side of the sheet on which the two extra solutions live i
 proved at one sheet point (:mod:`intervalkin.solve.fold_side`), and a piece can be
 proved empty.  A fold box counts as certified volume when each piece is known or empty.
 
+Window models (:mod:`intervalkin.space.joint_windows`, on with ``fold``): the undecided leaves left
+without a fold model get a certified count at each of their points, proved at the point
+(proofs/lemma-window-model.md); they are not cut into proved pieces, so they stay open for the counts.
+
 What is NOT claimed: two cells are not proved to be different components of the
 joint box minus g(S) (they may still join through undecided boxes), and undecided
 boxes may hide small cells.  Counting cells exactly needs a model for every
@@ -258,8 +262,8 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         re-tested, modelled again), the last step of the local refinement.
     windows : with ``fold``, give the leaves left without a model window models
         (:mod:`intervalkin.space.joint_windows`): certified counts at their points.  On the paper's
-        manipulator at the default depth they cover about three quarters of that volume, in about
-        40 s.
+        manipulator at the default depth: 80265 of 107742 such leaves, 74 % of their volume, in
+        23 s (the paving without them: about 65 s).
 
     Cost: the undecided boxes lie along the 2-D surface g(S), so their number grows
     like 4**depth; each cell costs one certified solve.
