@@ -71,7 +71,9 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
     places = jc.get("open_places") or {}
     if places.get("count"):
         out += [f"What is left open: {places['count']} places (face-connected groups of leaves without a "
-                f"certified count), {places['volume_without_model']:.2f} of volume without a local model. "
+                f"certified count), {places['volume_without_model']:.2f} of volume without a local model of any "
+                f"kind, {places.get('volume_window_model', 0.0):.2f} with a window model (a certified count at each "
+                "point, pieces not proved connected). "
                 "A cell could hide in a place, or two cells meet through one, so no upper bound is proved. "
                 "The largest:\n",
                 "| volume | leaves | without a model | from (rho_1, rho_2, rho_3) | to | on a face |",

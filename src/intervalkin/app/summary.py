@@ -131,6 +131,7 @@ def joint_cells_summary(jp) -> dict:
                                  "volume": float(fs.get("unjoined_piece_volume", 0.0))},
         "inferred_piece_signatures": int(fs.get("inferred_piece_signatures", 0)),
         "empty_pieces": int(fs.get("empty_pieces", 0)),
+        "window_models": dict(fs.get("windows", {})),
         "open_places": jp.open_places()["places"],
         "certified": "every box of a cell is proved off g(S) (no singular pose has its joint vector in it: by the "
                      "torus search or by Krawczyk exclusion), or is a fold box: one sheet of g(S) crosses it as a "

@@ -20,7 +20,10 @@ geometry, by polarisation: f is evaluated (with the same Laurent-polynomial
 reduction the certified solver uses) at r = 0, +-e_i and e_i + e_j, which
 determine a quadratic exactly.  Each entry is then enclosed by two floats.
 
-What is certified: ``reduced_coefficients(geometry)`` returns float intervals
+The determinant D(phi) = m_2 x m_3 of the 2 x 2 position system does not depend on r:
+D(phi) = d_0 + d_1 cos phi + d_2 sin phi (``denominator``).
+
+What is certified: ``reduced_equation(geometry)`` returns float intervals
 that contain the exact entries of C.  The polarisation identity is exact for a
 polynomial of degree 2, and ``tests/solve/test_simple_roots.py`` compares the form
 with the direct reduction at random r and phi in arb.
@@ -39,7 +42,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.sextic import reduction
 
-__all__ = ["MONOMIALS", "HARMONICS", "ReducedEquation", "reduced_equation"]
+__all__ = ["MONOMIALS", "HARMONICS", "ReducedEquation", "reduced_equation", "denominator"]
 
 #: Exponent pairs of the monomials in r (() is the constant, (i,) is r_i, (i, j) is r_i r_j).
 MONOMIALS: tuple[tuple[int, ...], ...] = ((), (0,), (1,), (2,), (0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
@@ -111,3 +114,18 @@ def reduced_equation(geometry: Geometry) -> ReducedEquation:
             for h, value in enumerate(col):
                 lo[h, m], hi[h, m] = arb_to_bounds(value)
     return ReducedEquation(Interval(lo, hi))
+
+
+@functools.lru_cache(maxsize=32)
+def denominator(geometry: Geometry) -> Interval:
+    """Enclosures (3,) of (d_0, d_1, d_2) with D(phi) = d_0 + d_1 cos phi + d_2 sin phi, from the exact geometry.
+
+    D is the Laurent polynomial of :func:`intervalkin.kinematics.sextic.reduction` (harmonics -1..1),
+    independent of r; its real Fourier coefficients are read as in :func:`_fourier`.
+    """
+    with ctx.workprec(_PRECISION):
+        D = reduction(geometry, [arb(0), arb(0), arb(0)]).D
+        d1 = D.get(1)
+        values = [D[0].real, 2 * d1.real, -2 * d1.imag] if d1 is not None else [D[0].real, arb(0), arb(0)]
+        bounds = [arb_to_bounds(v) for v in values]
+    return Interval(np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds]))

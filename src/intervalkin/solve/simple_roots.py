@@ -54,7 +54,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, Interval
 from intervalkin.kinematics.reduced_equation import HARMONICS, MONOMIALS, reduced_equation
 
-__all__ = ["initial_pieces", "open_pieces", "PIECES", "HALVINGS"]
+__all__ = ["initial_pieces", "open_pieces", "ReducedBoxes", "PIECES", "HALVINGS"]
 
 #: Pieces of the orientation circle tried first on every box.
 PIECES = 24
@@ -84,7 +84,7 @@ def _basis(phi: Ball, deriv: int) -> Ball:
     return Ball(np.stack(mids, axis=-1), np.stack(rads, axis=-1))
 
 
-class _Boxes:
+class ReducedBoxes:
     """Per-box data of the Taylor form in r (computed once, gathered per piece).
 
     For fixed phi, f(phi; r) = sum_h c_h(r) basis_h(phi) with c_h quadratic in r,
@@ -95,6 +95,9 @@ class _Boxes:
     w = basis(phi) and Q_h the quadratic part of c_h.  Over a piece Phi, w is a
     ball; the coefficients sum_h w_h Q_h of the monomials d_i d_j are computed per
     piece, and |d_i| <= h_i (the half-width of R_i^2) bounds them.
+
+    Public because :mod:`intervalkin.solve.window_model` encloses higher phi-derivatives
+    with it, and evaluates it on point boxes (lo = hi: R^2 is then the rounded square).
     """
 
     def __init__(self, geometry: Geometry, boxes: np.ndarray):
@@ -202,7 +205,7 @@ def open_pieces(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np
             o, a, b = open_pieces(geometry, boxes[k:k + _CHUNK], owner[sel] - k, lo[sel], hi[sel], halvings)
             parts.append((o + k, a, b))
         return tuple(np.concatenate([p[i] for p in parts]) for i in range(3))  # type: ignore[return-value]
-    data = _Boxes(geometry, np.asarray(boxes, dtype=np.float64))
+    data = ReducedBoxes(geometry, np.asarray(boxes, dtype=np.float64))
     done_owner, done_lo, done_hi = [], [], []
     lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
     for round_ in range(halvings + 1):

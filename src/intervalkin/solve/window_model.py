@@ -1,0 +1,378 @@
+"""Window models of joint boxes: the roots of the reduced equation that may merge, bounded by Rolle.
+
+The claim
+---------
+Let R be a joint box, r = rho^2 and f(phi; r) the reduced equation
+(:mod:`intervalkin.kinematics.reduced_equation`), D(phi) the determinant of the 2 x 2
+position system.  The circle of orientations is cut into pieces; each piece is *settled*
+(f != 0, or df/dphi != 0, over R^2 x piece) or *open*.  Cut points where the sign of f is
+certified for all r in R^2 split the circle into *arcs*:
+
+* an arc of one piece with f != 0 holds no root;
+* an arc of monotone pieces (one sign s of df/dphi) holds exactly one root, simple, when
+  the signs of f at its ends differ, and none otherwise; the root has D != 0 and the
+  sign of det A is DET_SIGN * sign(D) * s (proofs/lemma-window-model.md);
+* an arc with an open piece is a *window* [a, b].  On it D != 0 and the d-th
+  phi-derivative of f has one strict sign over R^2 x [a, b], d = 2 (a pair window) or
+  d = 3 (a triple window): by Rolle f(.; r) has at most d roots in [a, b] counted with
+  multiplicity, for every r, and their number has the parity of [sign f(a) != sign f(b)].
+
+A box is modelled (``ok``) when every window is a pair or a triple window.  Then the
+roots off the windows, their number and their det A signs, are the same for every r in
+R (:attr:`WindowModels.off`), and the signature at a point q of R is that plus the roots
+in each window at q, counted by :func:`window_signature` from certified signs of f(.; q).
+
+What is certified: every sign used is proved with ball arithmetic over (R^2, piece)
+(:class:`intervalkin.solve.simple_roots.ReducedBoxes`, outward by construction, cos and
+sin included).  What is not: a window model says nothing about how many connected pieces
+R minus g(S) has; it proves the count at each point q from a test at q.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from intervalkin.core.ball import Ball, cos_sin_multiple
+from intervalkin.core.errors import InputError
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import PI_HI, PI_LO, Interval, sign_label
+from intervalkin.kinematics.reduced_equation import denominator
+from intervalkin.solve.simple_roots import PIECES, ReducedBoxes, initial_pieces
+
+__all__ = ["WindowModels", "window_models", "window_signature", "denominator_enclosure", "DET_SIGN",
+           "WINDOW_HALVINGS", "DEGREE_HALVINGS", "POINT_HALVINGS"]
+
+#: At a simple root phi* of f with D(phi*) != 0: sign det A = DET_SIGN * sign D(phi*) * sign f'(phi*).
+#: det A = D g' exactly at a solution, with f = D^2 g (proofs/lemma-window-model.md, step 2).
+DET_SIGN = 1
+#: Bisections of a piece before it is left open (one fewer than the simple-roots test: on the default
+#: paving's no-model leaves the same share is modelled, in a third less time).
+WINDOW_HALVINGS = 6
+#: Bisections of a window's pieces while proving the sign of D and of the d-th derivative.
+DEGREE_HALVINGS = 3
+#: Bisections of the sub-pieces of a window at a point before the point is left undecided.
+POINT_HALVINGS = 18
+#: Boxes modelled together (bounded memory).
+_CHUNK = 4096
+#: Pieces narrower than this are not bisected further.
+_MIN_WIDTH = 2.0**-30
+
+
+@dataclass(frozen=True, eq=False)
+class WindowModels:
+    """Window models of n joint boxes.
+
+    Attributes
+    ----------
+    boxes : (n, 3, 2) the joint boxes R.
+    ok : (n,) bool, every window of the box is a pair or a triple window (and the roots off
+        the windows have certified det A signs).
+    off : (n, 3) int64, (count, n_wa1, n_wa2) of the roots off the windows, the same for every
+        point of the box (-1 where not ok).
+    window_box : (w,) int64, the box of each window (sorted; windows of boxes not ok are dropped).
+    degree : (w,) int8, 2 or 3: the bound on the roots in the window, with multiplicity.
+    end_signs : (w, 2) int8, certified sign of f at the window's first and last cut, for all r in R^2.
+    d_sign : (w,) int8, the sign of D on the window.
+    piece_window, piece_lo, piece_hi : (p,) the pieces of each window in circle order (a window
+        may run across phi = pi: its pieces then end at PI_HI and restart at -PI_HI).
+    """
+
+    boxes: np.ndarray
+    ok: np.ndarray
+    off: np.ndarray
+    window_box: np.ndarray
+    degree: np.ndarray
+    end_signs: np.ndarray
+    d_sign: np.ndarray
+    piece_window: np.ndarray
+    piece_lo: np.ndarray
+    piece_hi: np.ndarray
+
+    def concat(self, other: "WindowModels") -> "WindowModels":
+        """The models of these boxes followed by those of ``other`` (window and piece indices shifted)."""
+        n, w = len(self.ok), len(self.degree)
+        return WindowModels(*(np.concatenate([a, b]) for a, b in (
+            (self.boxes, other.boxes), (self.ok, other.ok), (self.off, other.off),
+            (self.window_box, other.window_box + n), (self.degree, other.degree),
+            (self.end_signs, other.end_signs), (self.d_sign, other.d_sign),
+            (self.piece_window, other.piece_window + w), (self.piece_lo, other.piece_lo),
+            (self.piece_hi, other.piece_hi))))
+
+    def windows_of(self, box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(first window, number of windows) of each box index in ``box``."""
+        start = np.searchsorted(self.window_box, box, side="left")
+        return start, np.searchsorted(self.window_box, box, side="right") - start
+
+
+def denominator_enclosure(geometry: Geometry, lo: np.ndarray, hi: np.ndarray) -> Interval:
+    """Enclosure of D(phi) = d_0 + d_1 cos phi + d_2 sin phi over [lo, hi] (mean value form and natural form)."""
+    d = Ball.from_interval(denominator(geometry))
+    piece = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
+
+    def value(phi: Ball, deriv: int) -> Ball:
+        c, s = cos_sin_multiple(phi, 1, deriv)  # deriv 1: (-sin, cos), and d_0 drops out
+        trig = d[1] * c + d[2] * s
+        return trig + d[0] if deriv == 0 else trig
+
+    at_mid = value(Ball.point(piece.mid), 0)
+    mv = (at_mid + value(piece, 1) * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
+    return mv.intersect(value(piece, 0).to_interval())
+
+
+def _node(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The interval of a cut point: [x, x], or around phi = pi for the seam cut (+-PI_HI)."""
+    seam = np.abs(x) == PI_HI
+    return np.where(seam, -PI_HI * (x < 0) + PI_LO * (x > 0), x), np.where(seam, -PI_LO * (x < 0) + PI_HI * (x > 0), x)
+
+
+def _settle(data: ReducedBoxes, n: int, pieces: int, halvings: int):
+    """Every piece, settled or open: (owner, lo, hi, kind, sign) sorted by owner and lo.
+
+    kind 0: f != 0 on R^2 x piece (sign: of f); 1: df/dphi != 0 (sign: of df/dphi); 2: open.
+    """
+    owner, lo, hi = initial_pieces(n, pieces)
+    out: list[tuple] = []
+    for round_ in range(halvings + 1):
+        sf = sign_label(data.enclosure(owner, lo, hi, 0))
+        kind, sign = np.where(sf != 0, 0, 2).astype(np.int8), sf.copy()
+        idx = np.flatnonzero(sf == 0)
+        if idx.size:
+            sd = sign_label(data.enclosure(owner[idx], lo[idx], hi[idx], 1))
+            kind[idx], sign[idx] = np.where(sd != 0, 1, 2), sd
+        stop = (kind != 2) | (hi - lo < _MIN_WIDTH) | (round_ == halvings)
+        out.append((owner[stop], lo[stop], hi[stop], kind[stop], sign[stop]))
+        owner, lo, hi = owner[~stop], lo[~stop], hi[~stop]
+        if owner.size == 0:
+            break
+        mid = np.minimum(np.maximum(0.5 * lo + 0.5 * hi, lo), hi)
+        owner, lo, hi = np.concatenate([owner, owner]), np.concatenate([lo, mid]), np.concatenate([mid, hi])
+    cols = [np.concatenate([o[i] for o in out]) for i in range(5)]
+    order = np.lexsort((cols[1], cols[0]))
+    return tuple(c[order] for c in cols)
+
+
+def _uniform(values: np.ndarray, group: np.ndarray, n: int) -> np.ndarray:
+    """(n,) the common value of ``values`` over each group when it is one non-zero sign, else 0."""
+    lo, hi = np.full(n, 2, dtype=np.int64), np.full(n, -2, dtype=np.int64)
+    np.minimum.at(lo, group, values)
+    np.maximum.at(hi, group, values)
+    return np.where((lo == hi) & (lo != 0), lo, 0)
+
+
+def _degree(geometry: Geometry, data: ReducedBoxes, box: np.ndarray, window: np.ndarray, lo: np.ndarray,
+            hi: np.ndarray, d: int, n_windows: int, halvings: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per window: the one strict sign of the d-th derivative of f over it, and of D (0: not proved)."""
+    parts_w, parts_f, parts_d = [], [], []
+    for round_ in range(halvings + 1):
+        sf = sign_label(data.enclosure(box[window], lo, hi, d))
+        sd = sign_label(denominator_enclosure(geometry, lo, hi))
+        stop = ((sf != 0) & (sd != 0)) | (hi - lo < _MIN_WIDTH) | (round_ == halvings)
+        parts_w.append(window[stop]), parts_f.append(sf[stop]), parts_d.append(sd[stop])
+        window, lo, hi = window[~stop], lo[~stop], hi[~stop]
+        if window.size == 0:
+            break
+        mid = np.minimum(np.maximum(0.5 * lo + 0.5 * hi, lo), hi)
+        window, lo, hi = np.concatenate([window, window]), np.concatenate([lo, mid]), np.concatenate([mid, hi])
+    w = np.concatenate(parts_w)
+    return _uniform(np.concatenate(parts_f), w, n_windows), _uniform(np.concatenate(parts_d), w, n_windows)
+
+
+def window_models(geometry: Geometry, boxes: np.ndarray, pieces: int = PIECES, halvings: int = WINDOW_HALVINGS,
+                  degree_halvings: int = DEGREE_HALVINGS) -> WindowModels:
+    """Window models of joint boxes (n, 3, 2), rho > 0; vectorised over boxes and pieces.
+
+    Cost: like the simple-roots test (:func:`intervalkin.solve.simple_roots.open_pieces`), plus
+    the enclosures of the 2nd and 3rd phi-derivatives over the windows' pieces.
+    """
+    boxes = np.asarray(boxes, dtype=np.float64)
+    if boxes.ndim != 3 or boxes.shape[1:] != (3, 2):
+        raise InputError(f"boxes: expected shape (n, 3, 2), got {boxes.shape}")
+    if np.any(~(boxes[:, :, 0] > 0)) or np.any(~(boxes[:, :, 0] <= boxes[:, :, 1])):
+        raise InputError("boxes: expected 0 < lo <= hi in every coordinate")
+    if len(boxes) == 0:
+        z = np.zeros(0, dtype=np.int64)
+        return WindowModels(boxes, z.astype(bool), np.zeros((0, 3), np.int64), z, z.astype(np.int8),
+                            np.zeros((0, 2), np.int8), z.astype(np.int8), z, z.astype(float), z.astype(float))
+    parts = [_chunk(geometry, boxes[k:k + _CHUNK], pieces, halvings, degree_halvings)
+             for k in range(0, len(boxes), _CHUNK)]
+    base_box = np.cumsum([0] + [len(p.ok) for p in parts])
+    base_win = np.cumsum([0] + [len(p.degree) for p in parts])
+    cat = np.concatenate
+    return WindowModels(boxes, cat([p.ok for p in parts]), cat([p.off for p in parts]),
+                        cat([p.window_box + b for p, b in zip(parts, base_box)]), cat([p.degree for p in parts]),
+                        cat([p.end_signs for p in parts]), cat([p.d_sign for p in parts]),
+                        cat([p.piece_window + b for p, b in zip(parts, base_win)]),
+                        cat([p.piece_lo for p in parts]), cat([p.piece_hi for p in parts]))
+
+
+def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, degree_halvings: int) -> WindowModels:
+    n = len(boxes)
+    data = ReducedBoxes(geometry, boxes)
+    owner, lo, hi, kind, sign = _settle(data, n, pieces, halvings)
+    m = owner.size
+    first, count = np.searchsorted(owner, np.arange(n)), np.bincount(owner, minlength=n)
+    pos = np.arange(m) - first[owner]
+    prev = np.where(pos == 0, first[owner] + count[owner] - 1, np.arange(m) - 1)  # cyclic, across phi = pi
+    # the sign of f at the start cut of each piece: a point enclosure, or the sign of a neighbour with f != 0
+    cut = sign_label(data.enclosure(owner, *_node(lo), 0)).astype(np.int64)
+    for j in (np.arange(m), prev):
+        known = kind[j] == 0
+        assert not np.any(cut[known] * sign[j][known] < 0), "two enclosures of f disagree: unsound evaluation"
+        cut = np.where(known, sign[j], cut)
+    has_break = np.bincount(owner, weights=cut != 0, minlength=n) > 0
+    # rotate each box's pieces to start at its first certified cut: arcs are then contiguous runs
+    first_break = np.full(n, np.iinfo(np.int64).max)
+    np.minimum.at(first_break, owner[cut != 0], pos[cut != 0])
+    keep = np.flatnonzero(has_break[owner])
+    rot = (pos[keep] - first_break[owner[keep]]) % count[owner[keep]]
+    order = keep[np.lexsort((rot, owner[keep]))]
+    owner, lo, hi, kind, sign, cut = (a[order] for a in (owner, lo, hi, kind, sign, cut))
+    arc = np.cumsum(cut != 0) - 1
+    n_arcs = int(arc[-1]) + 1 if arc.size else 0
+    arc_first = np.flatnonzero(cut != 0)
+    arc_box = owner[arc_first]
+    last = np.append(arc_box[1:] != arc_box[:-1], True)
+    box_first_arc = np.searchsorted(arc_box, arc_box, side="left")
+    end_first = np.where(last, arc_first[box_first_arc], np.append(arc_first[1:], 0))
+    s_start, s_end = cut[arc_first], cut[end_first]
+    n_open = np.bincount(arc, weights=kind == 2, minlength=n_arcs)
+    n_zero = np.bincount(arc, weights=kind == 0, minlength=n_arcs)
+    assert np.all(np.bincount(arc, minlength=n_arcs)[n_zero > 0] == 1), "a piece with f != 0 inside an arc"
+    # arcs of monotone pieces: one root when the end signs differ; sign of D at it by the endpoint rule
+    mono_arc = (n_open == 0) & (n_zero == 0)
+    mono = kind == 1
+    sigma = _uniform(sign[mono], arc[mono], n_arcs)
+    d_piece = sign_label(denominator_enclosure(geometry, lo[mono], hi[mono])).astype(np.int64)
+    # where D may vanish on a monotone piece, f > 0 at its zeros (a root with D = 0 is multiple), so the
+    # root lies before the first zero (f' > 0) or after the last one (f' < 0): D there has the sign of D
+    # at the piece's start or end
+    end = np.where(sign[mono] > 0, lo[mono], hi[mono])
+    d_end = sign_label(denominator_enclosure(geometry, *_node(end))).astype(np.int64)
+    d_arc = _uniform(np.where(d_piece != 0, d_piece, d_end), arc[mono], n_arcs)
+    root = mono_arc & (s_start != s_end)
+    bad_arc = (mono_arc & (sigma == 0)) | (root & (d_arc == 0))
+    det = DET_SIGN * sigma * d_arc
+    off = np.stack([np.bincount(arc_box, weights=w, minlength=n) for w in (root, root & (det > 0), root & (det < 0))],
+                   axis=1).astype(np.int64)
+    # windows: arcs with an open piece
+    win_arc = np.flatnonzero(n_open > 0)
+    n_win = win_arc.size
+    wmap = np.full(n_arcs, -1, dtype=np.int64)
+    wmap[win_arc] = np.arange(n_win)
+    sel = np.flatnonzero(wmap[arc] >= 0)
+    pw, plo, phi = wmap[arc[sel]], lo[sel], hi[sel]
+    wbox = arc_box[win_arc]
+    f2, d2 = _degree(geometry, data, wbox, pw, plo, phi, 2, n_win, degree_halvings)
+    pair = (f2 != 0) & (d2 != 0)
+    rest = ~pair[pw]
+    f3, d3 = _degree(geometry, data, wbox, pw[rest], plo[rest], phi[rest], 3, n_win, degree_halvings)
+    triple = ~pair & (f3 != 0) & (d3 != 0)
+    degree = np.where(pair, 2, np.where(triple, 3, 0)).astype(np.int8)
+    d_sign = np.where(pair, d2, d3).astype(np.int8)
+    bad = np.bincount(arc_box, weights=bad_arc, minlength=n) + np.bincount(wbox, weights=degree == 0, minlength=n)
+    ok = has_break & (bad == 0)
+    off[~ok] = -1
+    wk = ok[wbox]
+    pk = wk[pw]
+    renumber = np.cumsum(wk) - 1
+    return WindowModels(boxes, ok, off, wbox[wk], degree[wk],
+                        np.stack([s_start[win_arc], s_end[win_arc]], axis=1)[wk].astype(np.int8), d_sign[wk],
+                        renumber[pw[pk]], plo[pk], phi[pk])
+
+
+def window_signature(geometry: Geometry, models: WindowModels, rows: np.ndarray, points: np.ndarray,
+                     halvings: int = POINT_HALVINGS) -> np.ndarray:
+    """(m, 3) int64: the certified (count, n_wa1, n_wa2) at joint vectors ``points`` (m, 3), -1 where undecided.
+
+    ``rows`` (m,) names the box of ``models`` that holds each point.  In each window the signs of
+    f(.; q) (r = q^2 an interval) are proved at cut points, bisected where needed: k sign changes
+    prove at least k roots; with k >= degree - 1 the degree and the parity prove exactly k, all
+    simple; otherwise every sub-piece must show f != 0, or df/dphi != 0 with certified end signs.
+    A root where f rises has det A of sign DET_SIGN * sign(D); where it falls, the other sign.
+    Undecided: boxes not modelled, points on or very near g(S) (a multiple root), and (never
+    when the model is sound) more sign changes than the degree or a sign at q against the model's.
+    """
+    rows = np.asarray(rows, dtype=np.int64)
+    q = np.asarray(points, dtype=np.float64)
+    if q.ndim != 2 or q.shape[1] != 3 or rows.shape != (len(q),):
+        raise InputError(f"points: expected shape (m, 3) and rows (m,), got {q.shape} and {rows.shape}")
+    box = models.boxes[rows]
+    if np.any(~((box[:, :, 0] <= q) & (q <= box[:, :, 1]))):
+        raise InputError("points: every point must lie in its box models.boxes[rows]")
+    out = np.full((len(q), 3), -1, dtype=np.int64)
+    live = np.flatnonzero(models.ok[rows])
+    wstart, wcount = models.windows_of(rows[live])
+    pt = np.repeat(np.arange(live.size), wcount)  # pairs (point, window)
+    win = np.repeat(wstart - (np.cumsum(wcount) - wcount), wcount) + np.arange(pt.size)
+    pstart = np.searchsorted(models.piece_window, win, side="left")
+    pcount = np.searchsorted(models.piece_window, win, side="right") - pstart
+    pair = np.repeat(np.arange(pt.size), pcount)  # sub-pieces, first the window's pieces
+    piece = np.repeat(pstart - (np.cumsum(pcount) - pcount), pcount) + np.arange(pair.size)
+    lo, hi = models.piece_lo[piece], models.piece_hi[piece]
+    data = ReducedBoxes(geometry, np.stack([q[live], q[live]], axis=-1))
+
+    def node_sign(at: np.ndarray, x: np.ndarray) -> np.ndarray:
+        return sign_label(data.enclosure(pt[at], *_node(x), 0)).astype(np.int64)
+
+    # the window's ends carry their certified signs over all of R^2; the other cuts are proved at q
+    s0, s1 = node_sign(pair, lo), node_sign(pair, hi)
+    head = np.r_[True, pair[1:] != pair[:-1]]
+    tail = np.r_[pair[1:] != pair[:-1], True]
+    s0[head], s1[tail] = models.end_signs[win[pair[head]], 0], models.end_signs[win[pair[tail]], 1]
+    done = np.zeros(pt.size, dtype=bool)
+    result = np.full((pt.size, 2), -1, dtype=np.int64)  # (roots, roots with det A > 0)
+    fixed = np.zeros(pair.size, dtype=bool)  # sub-piece proved: f != 0, or monotone with certified end signs
+    degree = models.degree[win].astype(np.int64)
+    rising = DET_SIGN * models.d_sign[win] > 0
+    for round_ in range(halvings + 1):
+        order = np.lexsort((lo, piece, pair))
+        pair, piece, lo, hi, s0, s1, fixed = (a[order] for a in (pair, piece, lo, hi, s0, s1, fixed))
+        open_ = np.flatnonzero(~fixed)
+        sf = sign_label(data.enclosure(pt[pair[open_]], lo[open_], hi[open_], 0)).astype(np.int64)
+        # f's sign on a sub-piece against a sign at its end (the model's, at a window end): refuse the pair
+        clash = np.bincount(pair[open_], weights=(sf * s0[open_] < 0) | (sf * s1[open_] < 0), minlength=pt.size) > 0
+        s0[open_] = np.where(sf != 0, sf, s0[open_])
+        s1[open_] = np.where(sf != 0, sf, s1[open_])
+        mono = np.flatnonzero(sf == 0)
+        sd = sign_label(data.enclosure(pt[pair[open_[mono]]], lo[open_[mono]], hi[open_[mono]], 1))
+        fixed[open_] = sf != 0
+        fixed[open_[mono]] = (sd != 0) & (s0[open_[mono]] != 0) & (s1[open_[mono]] != 0)
+        k, up = _changes(pair, s0, s1, pt.size)
+        whole = np.bincount(pair, weights=~fixed, minlength=pt.size) == 0
+        # at most `degree` roots with multiplicity, of the parity of k: k >= degree - 1 leaves only k
+        now = ~done & ~clash & (k <= degree) & ((k >= degree - 1) | whole)
+        result[now] = np.stack([k, np.where(rising, up, k - up)], axis=1)[now]
+        refuse = ~done & ((k > degree) | clash)  # more changes than the degree allows, or a clash: never if sound
+        result[refuse] = -1
+        done |= now | refuse
+        drop = done[pair]
+        pair, piece, lo, hi, s0, s1, fixed = (a[~drop] for a in (pair, piece, lo, hi, s0, s1, fixed))
+        if pair.size == 0 or round_ == halvings:
+            break
+        cut = np.flatnonzero(~fixed)
+        mid = np.minimum(np.maximum(0.5 * lo[cut] + 0.5 * hi[cut], lo[cut]), hi[cut])
+        sm = node_sign(pair[cut], mid)
+        pair, piece = np.r_[pair, pair[cut]], np.r_[piece, piece[cut]]
+        lo, hi = np.r_[lo, mid], np.r_[hi, hi[cut]]
+        hi[cut] = mid
+        s0, s1 = np.r_[s0, sm], np.r_[s1, s1[cut]]
+        s1[cut] = sm
+        fixed = np.r_[fixed, np.zeros(cut.size, dtype=bool)]
+    good = np.bincount(pt, weights=result[:, 0] < 0, minlength=live.size) == 0
+    total = np.stack([np.bincount(pt, weights=result[:, i], minlength=live.size) for i in (0, 1)], axis=1)
+    sig = models.off[rows[live]] + np.stack([total[:, 0], total[:, 1], total[:, 0] - total[:, 1]], axis=1).astype(np.int64)
+    out[live[good]] = sig[good]
+    return out
+
+
+def _changes(pair: np.ndarray, s0: np.ndarray, s1: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per pair: the sign changes of f along its sub-pieces (sorted), and how many of them rise."""
+    seq = np.stack([s0, s1], axis=1).ravel()
+    grp = np.repeat(pair, 2)
+    nz = seq != 0
+    v, g = seq[nz], grp[nz]
+    change = (v[1:] != v[:-1]) & (g[1:] == g[:-1])
+    return (np.bincount(g[1:][change], minlength=n),
+            np.bincount(g[1:][change & (v[1:] > 0)], minlength=n))
