@@ -52,7 +52,7 @@ import numpy as np
 from intervalkin.core.errors import InputError
 from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.workers import Workers, default_workers
+from intervalkin.core.workers import Workers, default_workers, one_blas_thread
 from intervalkin.paving.budget import check_depth
 from intervalkin.paving.tree import Paving
 from intervalkin.solve.fold_model import side_of
@@ -278,7 +278,7 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     count = default_workers() if workers is None else workers
     if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= 64:
         raise InputError(f"workers: expected an integer in 1..64, got {workers!r}")
-    with Workers(count) as pool:
+    with Workers(count) as pool, one_blas_thread():
         if depth >= DEFAULT_JOINT_DEPTH:  # large enough to use them: started while this process is small
             pool.start()
         return _pave(geometry, depth, join_levels, progress, fold, face_levels, model_levels, windows, pool)
