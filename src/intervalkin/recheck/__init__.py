@@ -20,4 +20,20 @@ Modules, from the ground up:
 :mod:`~intervalkin.recheck.model`
     rho_i^2 and det A over boxes (natural and mean value forms), the label tests.
 :mod:`~intervalkin.recheck.bisect`
-    every claimed label confirmed, refuted or left open, with vectorised bisection."""
+    every claimed label confirmed, refuted or left open, with vectorised bisection.
+:mod:`~intervalkin.recheck.paving_file`
+    ``pavings/workspace.npz`` read and validated, re-checked in full, one verdict.
+"""
+
+from intervalkin.recheck.paving_file import (
+    KIND,
+    RecheckReport,
+    WorkspaceLabels,
+    find_paving,
+    read_workspace_labels,
+    recheck_folder,
+    recheck_paving,
+)
+
+__all__ = ['KIND', 'RecheckReport', 'WorkspaceLabels', 'find_paving', 'read_workspace_labels',
+           'recheck_folder', 'recheck_paving']
