@@ -95,16 +95,18 @@ def test_report_compares_the_paper_and_links_existing_figures(run):
 def test_certificates_of_the_run_verify(verified, run):
     """``intervalkin verify DIR/certificates`` re-proves every claim: status 0, one 'verified:' line each.
 
-    Would catch a writer that puts in a claim its checker refuses, or a run whose files and
-    certificates disagree (another geometry, another depth).
+    One line more than the certificates hold claims: the re-check of every box label of
+    ``pavings/workspace.npz`` beside them (kind ``box_labels_all``).  Would catch a writer
+    that puts in a claim its checker refuses, or a run whose files and certificates disagree
+    (another geometry, another depth).
     """
     status, lines, err = verified
     assert status == 0, "\n".join(ln for ln in lines if not ln.startswith("verified"))
     assert lines and all(ln.startswith("verified: ") for ln in lines)
     index = json.loads((run[0] / "certificates" / "index.json").read_text())
     n_claims = sum(len(json.loads((run[0] / "certificates" / f).read_text())["claims"]) for f in index["files"])
-    assert len(lines) == n_claims
-    assert err.strip() == f"{n_claims} of {n_claims} claims verified"
+    assert len(lines) == n_claims + 1 and "(box_labels_all): " in lines[-1]
+    assert err.strip() == f"{n_claims + 1} of {n_claims + 1} claims verified"
     assert any("dkp.json#" in ln and "exactly 6 solutions" in ln for ln in lines)
 
 

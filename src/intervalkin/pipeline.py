@@ -46,6 +46,7 @@ from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.geometry import Geometry, default_geometry
 from intervalkin.core.status import Status
 from intervalkin.paving.budget import check_depth
+from intervalkin.recheck import recheck_folder
 from intervalkin.solve import dkp
 from intervalkin.space.aspect_topology import AspectTopology, prove_aspects
 from intervalkin.space.basic_region import (
@@ -389,10 +390,17 @@ def verify(path: str | Path) -> VerifyReport:
     """Re-prove every claim of a certificate folder with the independent checker (arb only).
 
     ``path`` is the certificate folder or an output folder holding ``certificates/``.
+    When it is an output folder holding ``pavings/workspace.npz`` (or that folder's
+    ``certificates/``), one more result, of kind ``box_labels_all``, re-proves every
+    INSIDE/OUTSIDE label of the workspace paving (:mod:`intervalkin.recheck`); a
+    malformed npz raises ``CertificateFormatError`` too.
     Raises :class:`~intervalkin.core.errors.InputError` (a ``CertificateFormatError``)
     when the folder or its index is missing or malformed; a claim that does not
     re-prove is a failed result, not an error.
     """
     root = Path(path)
     folder = root / "certificates" if (root / "certificates" / INDEX).is_file() else root
-    return VerifyReport(folder, tuple(verify_directory(folder)))
+    results = verify_directory(folder)
+    # an output folder's workspace paving: every box label re-proved, not only the certified sample
+    everything = recheck_folder(root)
+    return VerifyReport(folder, tuple(results) + (() if everything is None else (everything,)))

@@ -12,8 +12,10 @@ traceback; 1 on an internal failure (one line too).  What counts as bad input:
   can be checked then;
 * a file-system failure while reading or writing (``OSError``): one line
   naming the file;
-* ``verify`` on certificates that do not all re-prove: the verdicts on
-  stdout, one error line on stderr.
+* ``verify`` on certificates that do not all re-prove (or on an output
+  folder whose workspace paving holds a label that does not re-prove): the
+  verdicts on stdout, one error line on stderr; a malformed
+  ``pavings/workspace.npz`` is bad input (one line).
 
 Each sub-command has one ``_cmd_*`` function that parses nothing itself.
 """
@@ -241,9 +243,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="worker processes of the LocalCluster (default: one per core)")
     p.add_argument("--no-dashboard", action="store_true", help="do not serve the Dask dashboard")
 
-    p = sub.add_parser("verify", help="re-check a certificate folder with the independent checker (arb only)")
+    p = sub.add_parser("verify", help="re-check a certificate folder with the independent checker (arb), and "
+                                      "every box label of the workspace paving beside it")
     p.add_argument("dir", metavar="DIR",
-                   help="an output folder holding certificates/ (its summary.json is compared too), "
+                   help="an output folder holding certificates/ (its summary.json is compared too, and every "
+                        "W and det A label of pavings/workspace.npz is re-proved), "
                         "or a folder holding index.json and the claim files")
     for p in sub.choices.values():
         p.set_defaults(subparser=p)  # so that extra arguments are refused with the sub-command's usage
