@@ -1,7 +1,7 @@
 """Benchmark of the direct joint-space paving (a script, not a test).
 
     python benchmarks/bench_joint_paving.py [--depths 6 7] [--geometry FILE] [--samples 2000] [--no-fold]
-        [--model-levels 1] [--face-levels 3] [--workers 1]
+        [--model-levels 1] [--face-levels 3] [--workers 1] [--windows]
 
 Per depth: boxes, wall time, peak memory (resident set of this process; and, sampled
 every 0.2 s, the largest sum over this process and its workers of the memory each holds
@@ -107,6 +107,8 @@ def main() -> None:
     ap.add_argument("--model-levels", type=int, default=None, help="levels of local refinement (default: the library's)")
     ap.add_argument("--face-levels", type=int, default=None,
                     help="further levels for undecided boxes on the faces (default: the library's)")
+    ap.add_argument("--windows", action="store_true",
+                    help="window models for the leaves with no fold model (as analyze and paper do)")
     ap.add_argument("--workers", type=int, default=None, help="processes (default: the library's, two on 2 cores)")
     args = ap.parse_args()
     g = default_geometry() if args.geometry is None else load_geometry(args.geometry)
@@ -118,6 +120,8 @@ def main() -> None:
         extra["face_levels"] = args.face_levels
     if args.workers is not None:
         extra["workers"] = args.workers
+    if args.windows:
+        extra["windows"] = True
     for depth in args.depths:
         watch = _MemoryWatch()
         t0 = time.perf_counter()
@@ -137,6 +141,11 @@ def main() -> None:
                   f"{fs['fold_boxes']} ({fs['seconds']:.1f} s for their pieces); pieces joined to no cell: "
                   f"{fs['unjoined_piece_groups']} groups, volume {fs['unjoined_piece_volume']:.2f}; fragments "
                   f"{len(jp.fragments)} (volume {sum(c.volume for c in jp.fragments):.3f})", flush=True)
+        if jp.fold_stats and "windows" in jp.fold_stats:
+            w = jp.fold_stats["windows"]
+            print(f"       window models: {w['leaves_modelled']} of {w['leaves_tried']} leaves without a fold model "
+                  f"(volume {w['volume_modelled']:.1f} of {w['volume_tried']:.1f}); {w['pair_windows']} pair and "
+                  f"{w['triple_windows']} triple windows; {w['seconds']:.1f} s", flush=True)
         print("       undecided volume per stage: " + ", ".join(
             f"{st['stage']} {st['level']}: {st['undecided_volume']['clear']:.0f}" for st in jp.paving.stats), flush=True)
         print("       cells: " + "; ".join(f"{c.count} ({c.n_wa1}+{c.n_wa2}) vol {c.volume:.2f} at "

@@ -62,11 +62,11 @@ def aspect_topology(paper_geometry):
 
 @pytest.fixture(scope="session")
 def fold_paving(paper_geometry):
-    """The joint box paved directly with fold models, depth 5 and one join level (about 3 s): the source
-    of the ``joint_fold_model`` and ``joint_join`` claims in tests/certify and tests/checker."""
+    """The joint box paved directly with fold models and window models, depth 5 and one join level: the
+    source of the ``joint_fold_model`` and ``joint_join`` claims in tests/certify and tests/checker."""
     from intervalkin.space.joint_paving import pave_joint_space
 
-    return pave_joint_space(paper_geometry, 5, 1, fold=True, model_levels=1)
+    return pave_joint_space(paper_geometry, 5, 1, fold=True, model_levels=1, windows=True)
 
 
 SECOND_DESIGN = Path(__file__).parents[1] / "examples" / "second_design_0246.toml"

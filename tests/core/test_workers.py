@@ -23,7 +23,7 @@ def test_parts_cover_the_items_once():
         parts = w.parts(n)
         covered = np.concatenate([np.arange(a, b) for a, b in parts]) if parts else np.zeros(0)
         assert np.array_equal(covered, np.arange(n))
-        assert len(parts) == (3 if n >= 10 else 1)
+        assert (len(parts) > 1) == (n >= 10)
 
 
 def test_owned_rows_follow_the_owners():
@@ -36,9 +36,9 @@ def test_run_keeps_the_order_and_uses_a_second_process():
     with Workers(2) as w:
         parts = w.parts(len(x))
         out = w.run(_square_and_pid, [(x[a:b],) for a, b in parts])
-    assert len(out) == 2
+    assert len(out) == len(parts) > 1
     assert np.array_equal(np.concatenate([o for o, _ in out]), x * x)
-    assert out[0][1] == os.getpid() and out[1][1] != os.getpid()
+    assert out[0][1] == os.getpid() and any(pid != os.getpid() for _, pid in out)
 
 
 def test_bad_worker_counts_are_refused():

@@ -23,10 +23,12 @@ from typing import Any, Callable, Sequence
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-__all__ = ["Workers", "default_workers", "owned_rows", "one_blas_thread", "MIN_PARALLEL_ITEMS"]
+__all__ = ["Workers", "Pending", "default_workers", "owned_rows", "one_blas_thread", "MIN_PARALLEL_ITEMS"]
 
 #: Calls on fewer items than this run in this process (a part must outweigh the cost of shipping it).
 MIN_PARALLEL_ITEMS = 20000
+#: Parts per process of a large call: small enough that the last ones balance the load.
+PARTS_PER_PROCESS = 4
 
 
 def default_workers() -> int:
@@ -98,21 +100,55 @@ class Workers:
             self._pool = None
 
     def parts(self, n: int) -> list[tuple[int, int]]:
-        """Contiguous ranges [start, stop) covering range(n): one per process, or one when n is small."""
-        k = self.count if n >= (MIN_PARALLEL_ITEMS if self.min_items is None else self.min_items) else 1
+        """Contiguous ranges [start, stop) covering range(n): :data:`PARTS_PER_PROCESS` per process (parts no
+        smaller than half the threshold), or one when n is below the threshold or there is one process."""
+        least = MIN_PARALLEL_ITEMS if self.min_items is None else self.min_items
+        k = 1 if self.count == 1 or n < least else max(2, min(PARTS_PER_PROCESS * self.count, 2 * n // max(least, 1)))
         cuts = [n * i // k for i in range(k + 1)]
         return [(cuts[i], cuts[i + 1]) for i in range(k)]
 
     def run(self, fn: Callable[..., Any], calls: Sequence[tuple]) -> list:
-        """[fn(*args) for args in calls], the first call here and the others in the workers, concurrently."""
+        """[fn(*args) for args in calls], in order, computed by this process and the workers at once.
+
+        Every call but the first is queued for the workers; this process computes the first,
+        then takes back, from the end, the queued calls no worker has started, so neither
+        side waits long for the other whatever the calls cost.
+        """
         if len(calls) <= 1 or self.count == 1:
             return [fn(*args) for args in calls]
+        pending = self.later(fn, calls[1:])
+        first = _limited(fn, calls[0])
+        return [first] + pending.results()
+
+    def later(self, fn: Callable[..., Any], calls: Sequence[tuple]) -> "Pending":
+        """Queue the calls for the workers and return at once; :meth:`Pending.results` gathers them (this
+        process computes those no worker has started by then)."""
+        if self.count == 1:
+            return Pending(fn, list(calls), [None] * len(calls))
         self.start()
-        futures = [self._pool.submit(_limited, fn, args) for args in calls[1:]]
+        return Pending(fn, list(calls), [self._pool.submit(_limited, fn, args) for args in calls])
+
+
+class Pending:
+    """Calls queued for the workers (``None``: to be computed here)."""
+
+    def __init__(self, fn: Callable[..., Any], calls: list, futures: list):
+        self.fn, self.calls, self.futures = fn, calls, futures
+
+    def results(self) -> list:
+        """The results, in order: calls not started by a worker are taken back and computed here."""
+        out: list = [None] * len(self.calls)
         try:
-            first = _limited(fn, calls[0])
-            return [first] + [f.result() for f in futures]
+            for i in range(len(self.calls) - 1, -1, -1):
+                f = self.futures[i]
+                if f is None or f.cancel():
+                    out[i] = _limited(self.fn, self.calls[i])
+            for i, f in enumerate(self.futures):
+                if f is not None and not f.cancelled():
+                    out[i] = f.result()
+            return out
         except BaseException:
-            for f in futures:
-                f.cancel()
+            for f in self.futures:
+                if f is not None:
+                    f.cancel()
             raise

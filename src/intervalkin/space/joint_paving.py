@@ -244,7 +244,7 @@ def joint_domain(geometry: Geometry) -> np.ndarray:
 def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_levels: int = JOIN_LEVELS,
                      progress: Callable[[dict], None] | None = None, fold: bool = True,
                      face_levels: int = FACE_LEVELS, model_levels: int = MODEL_LEVELS,
-                     windows: bool = True, workers: int | None = None) -> JointSpacePaving:
+                     windows: bool = False, workers: int | None = None) -> JointSpacePaving:
     """Pave the joint box to ``depth`` with the clear-box test, join cells across walls, and count them.
 
     Parameters
@@ -263,7 +263,9 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         re-tested, modelled again), the last step of the local refinement.
     windows : with ``fold``, give the leaves left without a model window models
         (:mod:`intervalkin.space.joint_windows`): certified counts at their points.  On the paper's
-        manipulator at the default depth: 80265 of 107742 such leaves, 74 % of their volume.
+        manipulator at the default depth: 80265 of 107742 such leaves, 74 % of their volume, for
+        about 13 s more on two cores; off by default (they add point labels near cusps and crossings,
+        not cells), on in ``analyze`` and ``paper``.
     workers : processes (default: two on a machine with two cores or more, see
         :func:`intervalkin.core.workers.default_workers`); large steps are cut into parts
         computed at once, and the paving is the same bit for bit whatever the number.
@@ -337,7 +339,7 @@ def _pave(geometry: Geometry, depth: int, join_levels: int, progress, fold: bool
         if pieces is not None:
             every = {c.id: c.signature for c in found}
             from_cells = np.array([every.get(int(c), (-1, -1, -1)) for c in piece_cell], dtype=np.int64)
-            signatures = piece_signatures(geometry, paving.lo, paving.hi, pieces, from_cells.reshape(-1, 3))
+            signatures = piece_signatures(geometry, paving.lo, paving.hi, pieces, from_cells.reshape(-1, 3), pool)
         fold_stats = {"fold_boxes": 0 if pieces is None else len(pieces), "seconds": time.perf_counter() - t0,
                       "void_boxes": int(store.void_keys.size), "void_volume": store.void_volume,
                       "unjoined_piece_groups": unjoined[0], "unjoined_piece_volume": unjoined[1],

@@ -179,7 +179,7 @@ class PieceSignatures:
 
 
 def piece_signatures(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, pieces: FoldPieces,
-                     from_cells: np.ndarray) -> PieceSignatures:
+                     from_cells: np.ndarray, workers: Workers | None = None) -> PieceSignatures:
     """Signatures of the fold pieces: from their cells, else from the other piece of their box.
 
     from_cells (2 m, 3): the signature of each piece's cell, -1 where it has none.  For a box
@@ -195,9 +195,13 @@ def piece_signatures(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, pieces:
     side = np.zeros(m, dtype=np.int8)
     empty = np.zeros(m, dtype=np.int8)
     if need.size:
-        fs = pair_sides(geometry, np.stack([lo[pieces.box[need]], hi[pieces.box[need]]], axis=-1),
-                        pieces.models.take(need))
-        side[need], empty[need] = fs.side, fs.empty
+        # each box's side is proved on its own: in parts on the workers
+        workers = Workers(1) if workers is None else workers
+        boxes = np.stack([lo[pieces.box[need]], hi[pieces.box[need]]], axis=-1)
+        parts = workers.parts(need.size)
+        found = workers.run(pair_sides, [(geometry, boxes[a:b], pieces.models.take(need[a:b])) for a, b in parts])
+        for (a, b), fs in zip(parts, found):
+            side[need[a:b]], empty[need[a:b]] = fs.side, fs.empty
     # pieces joined to each other (not to a cell) form groups of one signature
     e = pieces.edges
     pp = (e[0] >= n) & (e[1] >= n)
