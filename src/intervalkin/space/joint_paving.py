@@ -31,7 +31,7 @@ their box has one: the side of the sheet on which the two extra solutions live i
 proved at one sheet point (:mod:`intervalkin.solve.fold_side`), and a piece can be
 proved empty.  A fold box counts as certified volume when each piece is known or empty.
 
-Window models (:mod:`intervalkin.space.joint_windows`, on with ``fold``): the undecided leaves left
+Window models (:mod:`intervalkin.space.joint_windows`, with ``windows=True``): the undecided leaves left
 without a fold model get a certified count at each of their points, proved at the point
 (proofs/lemma-window-model.md); they are not cut into proved pieces, so they stay open for the counts.
 
@@ -265,7 +265,7 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
         (:mod:`intervalkin.space.joint_windows`): certified counts at their points.  On the paper's
         manipulator at the default depth: 80265 of 107742 such leaves, 74 % of their volume, for
         about 13 s more on two cores; off by default (they add point labels near cusps and crossings,
-        not cells), on in ``analyze`` and ``paper``.
+        not cells; the paper run leaves them off to stay within two minutes).
     workers : processes (default: two on a machine with two cores or more, see
         :func:`intervalkin.core.workers.default_workers`); large steps are cut into parts
         computed at once, and the paving is the same bit for bit whatever the number.
