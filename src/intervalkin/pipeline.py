@@ -12,15 +12,12 @@
    witnesses;
 4. the uniqueness domains.
 
-It returns an :class:`Analysis`: the joint cells, the regions, the counts with their
-certified bounds (:class:`~intervalkin.core.status.Count`), and two questions asked of
-them, :meth:`Analysis.label` (a pose) and :meth:`Analysis.locate` (a joint vector), each
-answered with a :class:`~intervalkin.core.status.Status`.  :func:`verify` re-checks a
-certificate folder with the independent checker.
-
-Nothing here prints: the stages are reported to an optional ``progress`` callback as
-:class:`ProgressEvent` objects, and bad arguments raise
-:class:`~intervalkin.core.errors.InputError` naming the parameter.
+It returns an :class:`Analysis`: the joint cells, the regions, the counts with their certified
+bounds (:class:`~intervalkin.core.status.Count`), :meth:`Analysis.label` (a pose) and
+:meth:`Analysis.locate` (a joint vector), each answered with a
+:class:`~intervalkin.core.status.Status`.  :func:`verify` re-checks a certificate folder with the
+independent checker.  Nothing here prints: stages go to an optional ``progress`` callback as
+:class:`ProgressEvent` objects; bad arguments raise :class:`~intervalkin.core.errors.InputError`.
 """
 
 from __future__ import annotations
@@ -389,18 +386,15 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
 def verify(path: str | Path) -> VerifyReport:
     """Re-prove every claim of a certificate folder with the independent checker (arb only).
 
-    ``path`` is the certificate folder or an output folder holding ``certificates/``.
-    When it is an output folder holding ``pavings/workspace.npz`` (or that folder's
-    ``certificates/``), one more result, of kind ``box_labels_all``, re-proves every
-    INSIDE/OUTSIDE label of the workspace paving (:mod:`intervalkin.recheck`); a
-    malformed npz raises ``CertificateFormatError`` too.
-    Raises :class:`~intervalkin.core.errors.InputError` (a ``CertificateFormatError``)
-    when the folder or its index is missing or malformed; a claim that does not
-    re-prove is a failed result, not an error.
+    ``path`` is the certificate folder or an output folder holding ``certificates/``; with
+    ``pavings/workspace.npz`` beside them, one more result (``box_labels_all``) re-proves every
+    INSIDE/OUTSIDE box label of that paving (:mod:`intervalkin.recheck`), not only the sample.
+    Raises :class:`~intervalkin.core.errors.InputError` (a ``CertificateFormatError``) when the
+    folder, its index or the npz is malformed; a claim that does not re-prove is a failed
+    result, not an error.
     """
     root = Path(path)
     folder = root / "certificates" if (root / "certificates" / INDEX).is_file() else root
-    results = verify_directory(folder)
-    # an output folder's workspace paving: every box label re-proved, not only the certified sample
+    results = tuple(verify_directory(folder))
     everything = recheck_folder(root)
-    return VerifyReport(folder, tuple(results) + (() if everything is None else (everything,)))
+    return VerifyReport(folder, results + (() if everything is None else (everything,)))
