@@ -23,7 +23,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-__all__ = ["Workers", "Pending", "default_workers", "owned_rows", "one_blas_thread", "MIN_PARALLEL_ITEMS"]
+__all__ = ["Workers", "default_workers", "owned_rows", "one_blas_thread", "MIN_PARALLEL_ITEMS"]
 
 #: Calls on fewer items than this run in this process (a part must outweigh the cost of shipping it).
 MIN_PARALLEL_ITEMS = 20000
@@ -116,39 +116,19 @@ class Workers:
         """
         if len(calls) <= 1 or self.count == 1:
             return [fn(*args) for args in calls]
-        pending = self.later(fn, calls[1:])
-        first = _limited(fn, calls[0])
-        return [first] + pending.results()
-
-    def later(self, fn: Callable[..., Any], calls: Sequence[tuple]) -> "Pending":
-        """Queue the calls for the workers and return at once; :meth:`Pending.results` gathers them (this
-        process computes those no worker has started by then)."""
-        if self.count == 1:
-            return Pending(fn, list(calls), [None] * len(calls))
         self.start()
-        return Pending(fn, list(calls), [self._pool.submit(_limited, fn, args) for args in calls])
-
-
-class Pending:
-    """Calls queued for the workers (``None``: to be computed here)."""
-
-    def __init__(self, fn: Callable[..., Any], calls: list, futures: list):
-        self.fn, self.calls, self.futures = fn, calls, futures
-
-    def results(self) -> list:
-        """The results, in order: calls not started by a worker are taken back and computed here."""
-        out: list = [None] * len(self.calls)
+        futures = [self._pool.submit(_limited, fn, args) for args in calls[1:]]
+        out: list = [None] * len(calls)
         try:
-            for i in range(len(self.calls) - 1, -1, -1):
-                f = self.futures[i]
-                if f is None or f.cancel():
-                    out[i] = _limited(self.fn, self.calls[i])
-            for i, f in enumerate(self.futures):
-                if f is not None and not f.cancelled():
+            out[0] = _limited(fn, calls[0])
+            for i in range(len(futures), 0, -1):
+                if futures[i - 1].cancel():  # not started by a worker: computed here
+                    out[i] = _limited(fn, calls[i])
+            for i, f in enumerate(futures, start=1):
+                if not f.cancelled():
                     out[i] = f.result()
             return out
         except BaseException:
-            for f in self.futures:
-                if f is not None:
-                    f.cancel()
+            for f in futures:
+                f.cancel()
             raise
