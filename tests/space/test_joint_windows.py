@@ -2,8 +2,10 @@
 
 - the leaves tried are exactly the undecided leaves without a fold model, most get a model;
 - ``signature_of`` at random points of window-modelled leaves equals the certified solver;
-- ``open_places`` keeps those leaves open for the counts and reports their volume apart;
-  the npz columns are unchanged.
+- ``open_places`` keeps those leaves open for the counts and reports their volume apart, except
+  window-clear leaves and window folds (proved pieces); the npz columns are unchanged;
+- window pieces joined to a cell carry its signature, and points in them get a cell whose
+  signature is the certified solver's.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from fractions import Fraction
 import numpy as np
 
 from intervalkin.solve.dkp import solve
+from intervalkin.solve.window_fold import CLEAR, FOLD
 from tests.solve.shared import split_of
 
 
@@ -40,15 +43,50 @@ def test_signature_of_points_in_window_leaves_is_the_solvers(fold_paving, paper_
     assert np.array_equal(sig[decided], truth)
 
 
-def test_window_leaves_stay_open_for_the_counts(fold_paving):
+def test_window_leaves_without_pieces_stay_open_for_the_counts(fold_paving):
+    """Window-modelled leaves are open unless window-clear or a window fold; the volumes add up."""
     block = fold_paving.open_places()
     places = block["places"]
     v = fold_paving.paving.volume()
     w = fold_paving.windows
-    assert np.isclose(places["volume_window_model"], v[w.leaf[w.models.ok]].sum())
+    pieced = np.isin(w.folds.kind, (CLEAR, FOLD))
+    assert pieced.any() and not pieced[~w.models.ok].any()
+    assert np.isclose(places["volume_window_model"], v[w.leaf[w.models.ok & ~pieced]].sum())
+    assert np.isclose(places["volume_window_pieces"], v[w.leaf[pieced]].sum())
     assert np.isclose(places["volume_without_model"], v[w.leaf[~w.models.ok]].sum())
-    # open for the counts all the same: the undecided volume holds both
+    # open for the counts: the undecided volume holds the window-modelled leaves without pieces, not the pieced ones
     assert block["joint_volume"] >= (places["volume_window_model"] + places["volume_without_model"]) * (1 - 1e-9)
+    assert np.isclose(block["joint_volume"] + places["volume_window_pieces"] + v[fold_paving.cell >= 0].sum()
+                      + v[fold_paving.counted_fold_mask()].sum(), v.sum())
     assert "window model" in places["why"]
     assert set(fold_paving.columns()) == {"lo", "hi", "level", "cell", "count", "n_wa1", "n_wa2", "fold_axis",
                                           "cell_below", "cell_above", "count_below", "count_above"}
+
+
+def test_window_pieces_carry_their_cells_signature(fold_paving, paper_geometry):
+    """Window pieces joined to a cell have its signature (the paving checks it too: here independently), many
+    join one; points of window-pieced leaves get a cell whose signature is the certified solver's."""
+    w = fold_paving.windows
+    wc = fold_paving.window_cell
+    assert len(wc) == 2 * len(w.leaf)
+    joined = np.flatnonzero(wc >= 0)
+    assert joined.size > 100
+    sig = {c.id: c.signature for c in fold_paving.cells + fold_paving.fragments}
+    assert all(tuple(w.folds.signature[j // 2, j % 2]) == sig[int(wc[j])] for j in joined)
+    rng = np.random.default_rng(23)
+    rows = rng.choice(np.flatnonzero(np.isin(w.folds.kind, (CLEAR, FOLD))), 40, replace=False)
+    lo, hi = fold_paving.paving.lo[w.leaf[rows]], fold_paving.paving.hi[w.leaf[rows]]
+    points = lo + rng.uniform(0.01, 0.99, size=lo.shape) * (hi - lo)
+    cell = fold_paving.cell_of(points, paper_geometry)
+    at = np.flatnonzero(cell >= 0)
+    assert at.size >= 25
+    truth = [split_of(solve(paper_geometry, [Fraction(float(v)) for v in p])) for p in points[at]]
+    assert [sig[int(c)] for c in cell[at]] == [tuple(t) for t in truth]
+
+
+def test_certified_share_grows_with_window_pieces(fold_paving):
+    """The window-pieced leaves count as certified volume: the share is the clear, counted-fold and pieced volume."""
+    v = fold_paving.paving.volume()
+    known = (fold_paving.cell >= 0) | fold_paving.counted_fold_mask()
+    assert fold_paving.certified_share() > v[known].sum() / v.sum()
+    assert np.isclose(fold_paving.certified_share(), v[known | fold_paving.pieced_mask()].sum() / v.sum())

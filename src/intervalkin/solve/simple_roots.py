@@ -128,6 +128,12 @@ class ReducedBoxes:
         h = self.half
         self.quad_square = np.array([MONOMIALS[m][0] == MONOMIALS[m][1] for m in quad])
         self.quad_bound = np.stack([h[:, MONOMIALS[m][0]] * h[:, MONOMIALS[m][1]] for m in quad], axis=1) * (1.0 + 2.0**-40)
+        # point boxes (lo = hi, R^2 the rounded square): the coefficients c_h(R^2) as balls directly,
+        # the monomials of the balls r times C, which encloses them with the square's tiny width included
+        self.at_points = bool(np.all(boxes[:, :, 0] == boxes[:, :, 1]))
+        if self.at_points:
+            value = [ones if not e else r[e[0]] if len(e) == 1 else r[e[0]] * r[e[1]] for e in MONOMIALS]
+            self.values = _stack(value).matmul(Ct)  # (n, 7)
 
     def enclosure(self, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray, deriv: int) -> Interval:
         """Enclosure of d^deriv f / dphi^deriv over (box owner, piece [lo, hi]).
@@ -140,6 +146,8 @@ class ReducedBoxes:
         piece = Ball.from_interval(Interval(lo, hi))
 
         def over_r(w: Ball) -> Ball:
+            if self.at_points:
+                return w.dot(self.values[owner])
             t = Ball(w.mid[:, None, :], w.rad[:, None, :]).dot(taylor)  # (m, 4)
             spread = np.einsum("mi,mi->m", np.abs(t.mid[:, 1:]) + t.rad[:, 1:], half)
             q = w.matmul(Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy()))  # (m, 6)
@@ -158,6 +166,26 @@ class ReducedBoxes:
         mv = (at_mid + slope * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
         natural = over_r(_basis(piece, deriv)).to_interval()
         return mv.intersect(natural)
+
+
+    def r_slope(self, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray, axis: int) -> Interval:
+        """Enclosure of d f / d r_axis over (box owner, piece [lo, hi]), r_axis = rho_axis^2.
+
+        d c_h / d r_axis is affine in r: its value at r_c (a row of the Taylor data) plus
+        sum_i (d^2 c_h / d r_axis d r_i) d_i with |d_i| <= h_i; natural form in phi.
+        """
+        taylor = self.taylor[owner]
+        half = self.half[owner]
+        w = _basis(Ball.from_interval(Interval(lo, hi)), 0)
+        t = Ball(w.mid[:, None, :], w.rad[:, None, :]).dot(taylor)  # (m, 4)
+        q = w.matmul(Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy()))  # (m, 6)
+        quad = [e for e in MONOMIALS if len(e) == 2]
+        spread = np.zeros(len(owner))
+        for i in range(3):
+            k = quad.index((min(axis, i), max(axis, i)))
+            factor = 2.0 if i == axis else 1.0  # d^2 (r_a^2) / d r_a^2 = 2
+            spread += factor * (np.abs(q.mid[:, k]) + q.rad[:, k]) * half[:, i]
+        return Ball(t.mid[:, 1 + axis], t.rad[:, 1 + axis] + spread * (1.0 + 2.0**-40) + 2.0**-1000).to_interval()
 
 
 def _stack(parts: list[Ball], axis: int = -1) -> Ball:

@@ -31,6 +31,7 @@ from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 from intervalkin.solve.dkp import solve
 from intervalkin.space.joint_pieces import FoldPieces
+from intervalkin.space.joint_window_pieces import WindowPieces
 
 __all__ = ["JointSpaceCell", "CellSolver", "joining_paths", "regions_from_cells"]
 
@@ -90,8 +91,12 @@ class CellSolver:
         self._solved: dict[int, tuple[tuple[int, int, int], tuple[Fraction, Fraction, Fraction]]] = {}
         self.edges: np.ndarray = np.zeros((2, 0), dtype=np.int64)
         self._edges_of: tuple = ()  # (depth, level, ijk) of the paving ``edges`` belong to
-        #: (groups, volume) of fold pieces joined to no clear box at the last labelling
+        #: (groups, volume) of fold and window pieces joined to no clear box at the last labelling
         self.unjoined: tuple[int, float] = (0, 0.0)
+        #: cell id of each window piece (2 k,) at the last labelling, -1 where joined to none
+        self.window_cell: np.ndarray = np.zeros(0, dtype=np.int32)
+        #: the window pieces of the last labelling (None without them)
+        self.window_pieces: WindowPieces | None = None
 
     def _signature(self, lo: np.ndarray, hi: np.ndarray):
         witness = _exact_centre(lo, hi)
@@ -112,7 +117,8 @@ class CellSolver:
 
     def label(self, paving: Paving, fine_depth: int,
               pieces_of: Callable[[np.ndarray], FoldPieces | None] | None = None,
-              anchor: np.ndarray | None = None
+              anchor: np.ndarray | None = None,
+              windows_of: Callable[[np.ndarray, FoldPieces | None], WindowPieces | None] | None = None
               ) -> tuple[np.ndarray, list[JointSpaceCell], FoldPieces | None, np.ndarray]:
         """(cell id per box (-1 where undecided), the cells largest first, the fold pieces, cell id per piece).
 
@@ -121,31 +127,42 @@ class CellSolver:
         boxes and pieces into cells, and a cell with no clear box is solved at a
         witness of one of its pieces.  ``anchor`` (n,) bool, when given: components with
         no clear anchor box are *fragments*, listed after the cells (ids follow theirs).
+        ``windows_of(face_edges, pieces)``, when given, returns the window pieces
+        (:mod:`intervalkin.space.joint_window_pieces`); they join the graph the same way, and
+        their cells are left in ``self.window_cell``.
         """
         ok = paving.labels["clear"] == Label.INSIDE
         n = len(paving)
         self.edges = self._face_edges(paving, fine_depth)
         pieces = pieces_of(self.edges) if pieces_of is not None else None
         m2 = 2 * len(pieces) if pieces is not None else 0
-        if m2:
-            live = np.zeros(n + m2, dtype=bool)
+        wp = windows_of(self.edges, pieces) if windows_of is not None else None
+        self.window_pieces = wp
+        w2 = len(wp.witness) if wp is not None else 0
+        witness = np.concatenate([pieces.witness if m2 else np.zeros((0, 3)), wp.witness if w2 else np.zeros((0, 3))])
+        # half a fold box or window fold to each of its pieces: a float measure for ordering and reports
+        pv = np.repeat(np.concatenate([paving.volume()[pieces.box] if m2 else np.zeros(0),
+                                       paving.volume()[wp.box] if w2 else np.zeros(0)]), 2) / 2.0
+        if m2 or w2:
+            live = np.zeros(n + m2 + w2, dtype=bool)
             live[:n] = ok
-            live[n:] = np.isfinite(pieces.witness).all(axis=1)
-            live[pieces.edges.ravel()] = True
+            live[n:] = np.isfinite(witness).all(axis=1)
             both = ok[self.edges[0]] & ok[self.edges[1]]
-            e = np.concatenate([self.edges[:, both], pieces.edges], axis=1)
-            comp_all = _components(n + m2, e, live)
+            extra = [x.edges for x in (pieces, wp) if x is not None]
+            for x in extra:
+                live[x.ravel()] = True
+            e = np.concatenate([self.edges[:, both]] + extra, axis=1)
+            comp_all = _components(n + m2 + w2, e, live)
         else:
             comp_all = component_labels(n, self.edges, ok)
         # a cell holds at least one clear box; pieces joined to none are reported, not counted
         self.unjoined = (0, 0.0)
-        if m2:
+        if m2 or w2:
             has_clear = np.zeros(int(comp_all.max()) + 1, dtype=bool)
             has_clear[comp_all[:n][ok]] = True
             alone = (comp_all[n:] >= 0) & ~has_clear[np.maximum(comp_all[n:], 0)]
             groups = np.unique(comp_all[n:][alone]).size
-            vol_p = np.repeat(paving.volume()[pieces.box], 2) / 2.0
-            self.unjoined = (int(groups), float(vol_p[alone].sum()))
+            self.unjoined = (int(groups), float(pv[alone].sum()))
             remap = np.cumsum(has_clear) - 1
             comp_all = np.where((comp_all >= 0) & has_clear[np.maximum(comp_all, 0)],
                                 remap[np.maximum(comp_all, 0)], -1)
@@ -164,8 +181,7 @@ class CellSolver:
         ncomp = int(comp_all.max()) + 1 if (comp_all >= 0).any() else 0
         box_count = np.bincount(comp[ok], minlength=ncomp)
         comp_vol = np.bincount(comp[ok], weights=vol[ok], minlength=ncomp)
-        if m2:  # half a fold box to each of its pieces: a float measure for ordering and reports
-            pv = np.repeat(vol[pieces.box], 2) / 2.0
+        if m2 or w2:
             has = piece_comp >= 0
             comp_vol += np.bincount(piece_comp[has], weights=pv[has], minlength=ncomp)
         anchored = np.ones(ncomp, dtype=bool)
@@ -194,8 +210,8 @@ class CellSolver:
                     if sig[0] >= 0:
                         self._solved[int(keys[b])] = (sig, witness)  # only proved signatures are reused
                         break
-                if sig[0] < 0 and m2:
-                    for w in pieces.witness[p_order[p_start[c]:p_end[c]]][:4 * _TRIES]:
+                if sig[0] < 0 and (m2 or w2):
+                    for w in witness[p_order[p_start[c]:p_end[c]]][:4 * _TRIES]:
                         if np.isfinite(w).all():
                             sig, witness = self._signature(w, w)
                             if sig[0] >= 0:
@@ -205,7 +221,8 @@ class CellSolver:
         cell = np.full(len(paving), -1, dtype=np.int32)
         cell[ok] = new_id[comp[ok]]
         piece_cell = np.where(piece_comp >= 0, new_id[np.maximum(piece_comp, 0)], -1).astype(np.int32)
-        return cell, cells, pieces, piece_cell
+        self.window_cell = piece_cell[m2:]
+        return cell, cells, pieces, piece_cell[:m2]
 
 
 def _components(n: int, edges: np.ndarray, live: np.ndarray) -> np.ndarray:

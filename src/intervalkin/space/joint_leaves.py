@@ -23,7 +23,7 @@ from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving, box_bounds, split_boxes
 from intervalkin.solve.joint_box import initial_cells, live_cells
 
-__all__ = ["adaptive_leaves", "refine_leaves", "leaves_to_paving", "Leaves"]
+__all__ = ["adaptive_leaves", "refine_leaves", "leaves_to_paving", "Leaves", "timed_step"]
 
 #: (level, ijk, lo, hi, clear, owner, cells)
 Leaves = tuple[np.ndarray, ...]
@@ -153,3 +153,24 @@ def refine_leaves(geometry: Geometry, domain: np.ndarray, leaves: tuple[np.ndarr
         clo, chi, cclear, front = _test(geometry, domain, front, workers)
         out.add(front, clo, chi, cclear, np.ones(len(cclear), dtype=bool))
     return out.merge()
+
+
+def timed_step(progress, stats: list, store, stage: str, level: int, step: Callable, leaves, wall=None):
+    """Run one refinement step; record (and report) the boxes it split and the volume left undecided.
+
+    ``undecided_volume``: "clear" is the volume of the leaves not proved clear, "model" the
+    part of it without a fold model either (what further local refinement would split).
+    """
+    t0 = time.perf_counter()
+    out = step()
+    vol = np.prod(out[3] - out[2], axis=1)
+    open_ = ~out[4]
+    unresolved = store.unresolved(out) if store is not None else open_
+    st = {"stage": stage, "level": level, "depth": level, "seconds": time.perf_counter() - t0,
+          "boxes": int(len(out[0])), "split": 0 if wall is None else int(np.count_nonzero(wall)),
+          "undecided": int(np.count_nonzero(open_)),
+          "undecided_volume": {"clear": float(vol[open_].sum()), "model": float(vol[unresolved].sum())}}
+    stats.append(st)
+    if progress is not None:
+        progress(st)
+    return out

@@ -57,11 +57,13 @@ from intervalkin.paving.budget import check_depth
 from intervalkin.paving.tree import Paving
 from intervalkin.solve.fold_model import side_of
 from intervalkin.solve.fold_side import side_of_tight
-from intervalkin.space.joint_leaves import adaptive_leaves, leaves_to_paving, refine_leaves
+from intervalkin.space.joint_leaves import adaptive_leaves, leaves_to_paving, refine_leaves, timed_step
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
 from intervalkin.space.joint_models import ModelStore
 from intervalkin.space.joint_pieces import FoldPieces, PieceSignatures, piece_signatures
 from intervalkin.space.joint_places import open_places
+from intervalkin.space.joint_window_pieces import (check_window_cells, signatures_from_windows, window_cell_of,
+                                                   window_pieces)
 from intervalkin.space.joint_windows import JointWindows, joint_windows
 
 __all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain", "DEFAULT_JOINT_DEPTH", "JOIN_LEVELS", "MODEL_LEVELS"]
@@ -97,8 +99,9 @@ class JointSpacePaving:
     piece_signatures : the certified signature of each fold piece, from its cell or inferred from
         the other piece of its box (:func:`intervalkin.space.joint_pieces.piece_signatures`).
     windows : window models of the undecided leaves without a fold model (near cusps and crossings
-        of g(S); :mod:`intervalkin.space.joint_windows`): a certified signature at each of their points,
-        no proved pieces.
+        of g(S); :mod:`intervalkin.space.joint_windows`): a certified signature at each of their points;
+        the window-clear leaves and window folds among them are also cut into proved pieces.
+    window_cell : (2 k,) the cell of each window piece (piece s of window row j at 2 j + s), -1 where none.
     """
 
     paving: Paving
@@ -111,6 +114,7 @@ class JointSpacePaving:
     fragments: tuple[JointSpaceCell, ...] = ()
     piece_signatures: PieceSignatures | None = None
     windows: JointWindows | None = None
+    window_cell: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int32))
 
     def counted_fold_mask(self) -> np.ndarray:
         """(n,) bool: the leaves that are fold boxes each of whose pieces has a certified signature or is empty."""
@@ -124,13 +128,14 @@ class JointSpacePaving:
         leaves, the certified share, the fragments, the fold pieces joined to no cell, and the places
         (face-connected groups of open leaves, :mod:`intervalkin.space.joint_places`), the largest listed."""
         fs = self.fold_stats
-        open_leaf = (self.cell < 0) & ~self.counted_fold_mask()
+        open_leaf = (self.cell < 0) & ~self.counted_fold_mask() & ~self.pieced_mask()
         no_model = self.cell < 0
         if self.pieces is not None and len(self.pieces):
             no_model[self.pieces.box] = False
         p = self.paving
         windowed = self.windows.modelled_mask(len(self.cell)) if self.windows is not None else np.zeros_like(no_model)
-        no_model &= ~windowed  # open for the counts all the same: a window model proves no pieces
+        no_model &= ~windowed
+        windowed &= ~self.pieced_mask()  # open for the counts all the same: a point model proves no pieces
         n, largest = open_places(p.level, p.ijk, p.lo, p.hi, open_leaf, no_model, p.domain)
         return {"joint_volume": self.undecided_volume(), "joint_certified_share": self.certified_share(),
                 "fragments": [{"count": c.count, "volume": c.volume, "witness": [str(v) for v in c.witness]}
@@ -139,21 +144,31 @@ class JointSpacePaving:
                                          "volume": float(fs.get("unjoined_piece_volume", 0.0))},
                 "places": {"count": n, "volume_without_model": float(p.volume()[no_model].sum()),
                            "volume_window_model": float(p.volume()[windowed].sum()),
+                           "volume_window_pieces": float(p.volume()[self.pieced_mask()].sum()),
                            "why": "no model of any kind (volume_without_model, without_model): the Krawczyk test of "
                                   "the singular four-bar system failed for every axis (near cusp edges and "
                                   "crossings of g(S)) and the window model failed too; or a window model "
                                   "(volume_window_model: a certified count at each point, but the leaf's pieces "
-                                  "are not proved connected); or a fold box with a piece of unknown count",
+                                  "are not proved connected: a cusp window, several pair windows, or a slope "
+                                  "sign not certified); or a fold box with a piece of unknown count; "
+                                  "window-clear leaves and window folds (volume_window_pieces) are not open",
                            "largest": [q.to_json() for q in largest]}}
 
+    def pieced_mask(self) -> np.ndarray:
+        """(n,) bool: window-clear leaves and window folds (their pieces' signatures are fixed by their models)."""
+        if self.windows is None:
+            return np.zeros(len(self.cell), dtype=bool)
+        return self.windows.pieced_mask(len(self.cell))
+
     def undecided_volume(self) -> float:
-        """Volume of the leaves that are neither clear nor fold boxes with both pieces counted."""
-        return float(self.paving.volume()[(self.cell < 0) & ~self.counted_fold_mask()].sum())
+        """Volume of the leaves that are neither clear, nor fold boxes with both pieces counted, nor window-pieced."""
+        return float(self.paving.volume()[(self.cell < 0) & ~self.counted_fold_mask() & ~self.pieced_mask()].sum())
 
     def certified_share(self) -> float:
-        """Share of the joint box whose count is certified: clear boxes and fold boxes (both pieces counted)."""
+        """Share of the joint box whose count is certified: clear boxes, fold boxes (both pieces counted),
+        window-clear leaves and window folds."""
         v = self.paving.volume()
-        return float(v[(self.cell >= 0) | self.counted_fold_mask()].sum() / v.sum())
+        return float(v[(self.cell >= 0) | self.counted_fold_mask() | self.pieced_mask()].sum() / v.sum())
 
     def cell_of(self, rho: np.ndarray, geometry: Geometry | None = None) -> np.ndarray:
         """Cell id (m,) of each joint box or point rho (m, 3, 2) or (m, 3): the cell of the leaf that
@@ -166,8 +181,10 @@ class JointSpacePaving:
         boxes = np.stack([q, q], axis=-1) if q.ndim == 2 else q
         leaf = self.paving.locate_boxes(boxes)
         out = np.where(leaf >= 0, self.cell[np.maximum(leaf, 0)], -1)
-        if geometry is None or q.ndim != 2 or self.pieces is None or not len(self.pieces):
+        if geometry is None or q.ndim != 2:
             return out
+        if self.pieces is None or not len(self.pieces):
+            return self._window_cells(out, leaf, q, geometry)
         row = np.full(len(self.cell), -1, dtype=np.int64)
         row[self.pieces.box] = np.arange(len(self.pieces))
         t = np.where(leaf >= 0, row[np.maximum(leaf, 0)], -1)
@@ -176,6 +193,12 @@ class JointSpacePaving:
             side = side_of(geometry, self.pieces.models, t[at], q[at])
             pc = self.piece_cell.reshape(-1, 2)[t[at], (side > 0).astype(np.int64)]
             out[at] = np.where(side != 0, pc, -1)
+        return self._window_cells(out, leaf, q, geometry)
+
+    def _window_cells(self, out: np.ndarray, leaf: np.ndarray, q: np.ndarray, geometry: Geometry) -> np.ndarray:
+        at = np.flatnonzero((out < 0) & (leaf >= 0))
+        if self.windows is not None and len(self.window_cell) and at.size:
+            out[at] = window_cell_of(geometry, self.windows, self.window_cell, leaf[at], q[at])
         return out
 
     def signature_of(self, rho: np.ndarray, geometry: Geometry) -> np.ndarray:
@@ -293,12 +316,12 @@ def _pave(geometry: Geometry, depth: int, join_levels: int, progress, fold: bool
     leaves = found_leaves.merge()
     store = ModelStore(geometry, pool) if fold else None
     settle = (lambda lv: store.settle(lv)) if store is not None else (lambda lv: lv)
-    leaves = _timed(progress, stats, store, "local models", depth, lambda: settle(leaves), leaves)
+    leaves = timed_step(progress, stats, store, "local models", depth, lambda: settle(leaves), leaves)
     for extra in range(model_levels if store is not None else 0):
         wall = store.unresolved(leaves) & (leaves[0] >= depth + extra)
         if not np.any(wall):
             break
-        leaves = _timed(progress, stats, store, "local refinement", depth + extra + 1,
+        leaves = timed_step(progress, stats, store, "local refinement", depth + extra + 1,
                         lambda: settle(refine_leaves(geometry, domain, leaves, wall, pool)), leaves, wall)
     for extra in range(face_levels):
         # thin cells hug the faces rho_i = rho_min / rho_max: refine the undecided leaves that touch one
@@ -307,7 +330,7 @@ def _pave(geometry: Geometry, depth: int, join_levels: int, progress, fold: bool
         wall = ~clear & touch & (level >= depth + extra)
         if not np.any(wall):
             break
-        leaves = _timed(progress, stats, store, "faces", depth + extra + 1,
+        leaves = timed_step(progress, stats, store, "faces", depth + extra + 1,
                         lambda: settle(refine_leaves(geometry, domain, leaves, wall, pool)), leaves, wall)
     fine = top = int(leaves[0].max())
     cells = CellSolver(geometry)
@@ -325,60 +348,51 @@ def _pave(geometry: Geometry, depth: int, join_levels: int, progress, fold: bool
         wall = joining_paths(cells.edges, cell, found) & (paving.level < top + join_levels)
         if not np.any(wall):
             break
-        leaves = _timed(progress, stats, store, "joins", depth + extra + 1,
+        leaves = timed_step(progress, stats, store, "joins", depth + extra + 1,
                         lambda: settle(refine_leaves(geometry, domain, leaves, wall, pool)), leaves, wall)
         fine = max(fine, int(leaves[0].max()))
     pieces, piece_cell, fold_stats, signatures = None, np.zeros(0, dtype=np.int32), {}, None
+    found_windows, window_cell = None, np.zeros(0, dtype=np.int32)
     if store is not None:
         t0 = time.perf_counter()
         paving = leaves_to_paving(domain, leaves, stats)
-        cell, found, pieces, piece_cell = cells.label(paving, fine, lambda e: store.pieces(leaves, e),
-                                                      anchor(leaves))
+        wins = None
+        if windows:
+            found_windows = joint_windows(geometry, paving.lo, paving.hi, ~leaves[4] & (store.rows(leaves) < 0), pool)
+            if progress is not None:
+                progress({"stage": "window models", "level": fine, "depth": fine, "boxes": len(found_windows.leaf),
+                          "split": 0, "cells": 0})
+
+            def wins(e, fp):
+                return window_pieces(geometry, paving.lo, paving.hi, leaves[4], e, fp, found_windows, pool)
+        labelled = cells.label(paving, fine, lambda e: store.pieces(leaves, e), anchor(leaves), wins)
+        cell, found, pieces, piece_cell = labelled
+        window_cell = cells.window_cell
         unjoined = cells.unjoined
         signatures = None
+        every = {c.id: c.signature for c in found}
+        if found_windows is not None:
+            check_window_cells(window_cell, found_windows, every)
         if pieces is not None:
-            every = {c.id: c.signature for c in found}
             from_cells = np.array([every.get(int(c), (-1, -1, -1)) for c in piece_cell], dtype=np.int64)
+            if found_windows is not None and cells.window_pieces is not None:
+                near = signatures_from_windows(cells.window_pieces, found_windows, len(paving), len(pieces))
+                both = (from_cells[:, 0] >= 0) & (near[:, 0] >= 0)
+                if np.any(both & (from_cells != near).any(axis=1)):
+                    raise AssertionError("a fold piece's cell and its window neighbour disagree (unsound)")
+                from_cells = np.where(from_cells[:, :1] >= 0, from_cells, near)
             signatures = piece_signatures(geometry, paving.lo, paving.hi, pieces, from_cells.reshape(-1, 3), pool)
         fold_stats = {"fold_boxes": 0 if pieces is None else len(pieces), "seconds": time.perf_counter() - t0,
                       "void_boxes": int(store.void_keys.size), "void_volume": store.void_volume,
                       "unjoined_piece_groups": unjoined[0], "unjoined_piece_volume": unjoined[1],
                       "inferred_piece_signatures": 0 if signatures is None else signatures.inferred,
                       "empty_pieces": 0 if signatures is None else int(np.count_nonzero(signatures.empty))}
+        if found_windows is not None:
+            fold_stats["windows"] = found_windows.stats(paving.volume())
         if progress is not None:
             progress({"stage": "fold pieces", "level": fine, "depth": fine,
                       "boxes": fold_stats["fold_boxes"], "split": 0, "cells": len(found)})
     voided = store.voided(paving.level, paving.ijk) if store is not None else np.zeros(len(cell), dtype=bool)
-    found_windows = None
-    if store is not None and windows:
-        none = cell < 0
-        if pieces is not None and len(pieces):
-            none[pieces.box] = False
-        found_windows = joint_windows(geometry, paving.lo, paving.hi, none, pool)
-        fold_stats["windows"] = found_windows.stats(paving.volume())
-        if progress is not None:
-            progress({"stage": "window models", "level": fine, "depth": fine, "boxes": int(none.sum()),
-                      "split": 0, "cells": len(found)})
     return JointSpacePaving(paving, cell, tuple(c for c in found if not c.fragment), pieces, piece_cell,
-                            fold_stats, voided, tuple(c for c in found if c.fragment), signatures, found_windows)
-
-
-def _timed(progress, stats: list, store, stage: str, level: int, step: Callable, leaves, wall=None):
-    """Run one refinement step; record (and report) the boxes it split and the volume left undecided.
-
-    ``undecided_volume``: "clear" is the volume of the leaves not proved clear, "model" the
-    part of it without a fold model either (what further local refinement would split).
-    """
-    t0 = time.perf_counter()
-    out = step()
-    vol = np.prod(out[3] - out[2], axis=1)
-    open_ = ~out[4]
-    unresolved = store.unresolved(out) if store is not None else open_
-    st = {"stage": stage, "level": level, "depth": level, "seconds": time.perf_counter() - t0,
-          "boxes": int(len(out[0])), "split": 0 if wall is None else int(np.count_nonzero(wall)),
-          "undecided": int(np.count_nonzero(open_)),
-          "undecided_volume": {"clear": float(vol[open_].sum()), "model": float(vol[unresolved].sum())}}
-    stats.append(st)
-    if progress is not None:
-        progress(st)
-    return out
+                            fold_stats, voided, tuple(c for c in found if c.fragment), signatures, found_windows,
+                            window_cell)

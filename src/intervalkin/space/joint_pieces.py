@@ -32,7 +32,7 @@ from scipy.sparse.csgraph import connected_components
 from intervalkin.solve.fold_model import FoldModels, side_of
 from intervalkin.solve.fold_side import PAIR, pair_sides
 
-__all__ = ["FoldPieces", "fold_pieces", "FACE_FRACTIONS", "PieceSignatures", "piece_signatures"]
+__all__ = ["FoldPieces", "fold_pieces", "fold_sides", "FACE_FRACTIONS", "PieceSignatures", "piece_signatures"]
 
 #: Where points are placed on a shared face, as fractions of its two sides.
 FACE_FRACTIONS = ((0.5, 0.5), (0.1, 0.1), (0.1, 0.9), (0.9, 0.1), (0.9, 0.9))
@@ -75,7 +75,7 @@ def _face_points(lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: np.ndarray) -
     return pts
 
 
-def _sides(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray,
+def fold_sides(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray,
            workers: Workers) -> np.ndarray:
     """:func:`side_of` in parts on the workers; each part ships only the models its points use."""
     parts = workers.parts(len(box))
@@ -122,7 +122,7 @@ def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.nd
     for c, f in enumerate(INNER_FRACTIONS):
         inner[rows, c, k] = lo[box, k] + f * (hi[box, k] - lo[box, k])
     t_in = np.repeat(rows, len(INNER_FRACTIONS))
-    side_in = _sides(geometry, models, t_in, inner.reshape(-1, 3), workers)
+    side_in = fold_sides(geometry, models, t_in, inner.reshape(-1, 3), workers)
     good = side_in != 0
     covered = np.zeros(2 * m, dtype=bool)
     covered[2 * t_in[good] + (side_in[good] > 0)] = True
@@ -141,7 +141,7 @@ def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.nd
             is_model &= placed[0] | ~both_covered[np.maximum(t, 0)]
             ok[(t >= 0) & ~is_model] = False
         if is_model.any():
-            side = _sides(geometry, models, t[is_model], q[is_model], workers)
+            side = fold_sides(geometry, models, t[is_model], q[is_model], workers)
             nd[is_model] = n + 2 * t[is_model] + (side > 0)
             ok[is_model] = side != 0
         node.append(nd)

@@ -22,6 +22,7 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
+from intervalkin.solve.window_fold import CLEAR, FOLD, WindowFolds, window_folds
 from intervalkin.solve.window_model import WindowModels, window_models, window_signature
 
 __all__ = ["JointWindows", "joint_windows"]
@@ -36,11 +37,21 @@ class JointWindows:
     leaf : (k,) int64, sorted: the leaves that were given a window model to try (not clear, no fold model).
     models : the models, row j for leaf ``leaf[j]`` (``models.ok[j]``: modelled).
     seconds : the time spent building them.
+    folds : which models prove the leaf off g(S) (window-clear) or cut by one monotone sheet
+        into two connected pieces (window folds; :mod:`intervalkin.solve.window_fold`).
     """
 
     leaf: np.ndarray
     models: WindowModels
     seconds: float
+    folds: WindowFolds | None = None
+
+    def pieced_mask(self, n: int) -> np.ndarray:
+        """(n,) bool over the paving's leaves: the window-clear leaves and the window folds."""
+        out = np.zeros(n, dtype=bool)
+        if self.folds is not None:
+            out[self.leaf[np.isin(self.folds.kind, (CLEAR, FOLD))]] = True
+        return out
 
     def modelled_mask(self, n: int) -> np.ndarray:
         """(n,) bool over the paving's leaves: the leaves with a window model."""
@@ -67,7 +78,11 @@ class JointWindows:
         return {"leaves_tried": int(len(self.leaf)), "leaves_modelled": int(ok.sum()),
                 "volume_tried": float(volume[self.leaf].sum()), "volume_modelled": float(volume[self.leaf[ok]].sum()),
                 "pair_windows": int(np.count_nonzero(self.models.degree == 2)),
-                "triple_windows": int(np.count_nonzero(self.models.degree == 3)), "seconds": self.seconds}
+                "triple_windows": int(np.count_nonzero(self.models.degree == 3)), "seconds": self.seconds,
+                **({} if self.folds is None else {
+                    "window_clear": int(np.count_nonzero(self.folds.kind == CLEAR)),
+                    "window_folds": int(np.count_nonzero(self.folds.kind == FOLD)),
+                    "volume_pieced": float(volume[self.leaf[np.isin(self.folds.kind, (CLEAR, FOLD))]].sum())})}
 
 
 def joint_windows(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, no_model: np.ndarray,
@@ -78,8 +93,14 @@ def joint_windows(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, no_model: 
     leaf = np.flatnonzero(no_model).astype(np.int64)
     boxes = np.stack([lo[leaf], hi[leaf]], axis=-1)
     workers = Workers(1) if workers is None else workers
-    parts = workers.run(window_models, [(geometry, boxes[a:b]) for a, b in workers.parts(len(boxes))])
-    models = parts[0]
-    for m in parts[1:]:
+    parts = workers.run(_modelled, [(geometry, boxes[a:b]) for a, b in workers.parts(len(boxes))])
+    models, folds = parts[0]
+    for m, f in parts[1:]:
+        folds = folds.concat(f, len(models.degree))
         models = models.concat(m)
-    return JointWindows(leaf, models, time.perf_counter() - t0)
+    return JointWindows(leaf, models, time.perf_counter() - t0, folds)
+
+
+def _modelled(geometry: Geometry, boxes: np.ndarray) -> tuple[WindowModels, WindowFolds]:
+    models = window_models(geometry, boxes)
+    return models, window_folds(geometry, models)

@@ -1,0 +1,193 @@
+"""Window folds: joint boxes whose window model proves one monotone sheet of g(S), or none.
+
+A window model (:mod:`intervalkin.solve.window_model`, proofs/lemma-window-model.md)
+of a joint box R cuts the circle of orientations into arcs whose roots are the same
+on all of R and *windows* where roots may merge.  Classify each window by its degree
+d (2 or 3: at most d roots with multiplicity) and the end signs of f:
+
+* *constant*: d = 2 and the end signs differ: exactly one simple root for every
+  r in R^2 (odd parity, at most two), whose det A sign follows from the direction in
+  which f crosses zero and the sign of D on the window;
+* *pair*: the end signs agree (s = the common sign): 0 or 2 roots.  With
+  u(r) = min over the window of s f(phi; r), the window holds two simple roots where
+  u < 0, none where u > 0, and a double root (a point of g(S)) where u = 0;
+* *cusp*: d = 3 and the end signs differ: one or three roots (a cusp edge may pass).
+
+R is a *window-clear* box when it has no pair and no cusp window: every root is simple
+on all of R, so R lies off g(S) and its signature is the same everywhere.  R is a
+*window fold* when it has exactly one pair window, no cusp window, and the sign of
+s df/dr_l is certified over R^2 x window for l = 1, 2, 3.  Then u is strictly
+monotone in each rho_l (r_l = rho_l^2, rho_l > 0) with known directions, g(S) meets R
+exactly in {u = 0}, and R minus g(S) is two pieces, each connected or empty:
+
+* piece 0, {u > 0}: the window holds no root; it holds the corner where u is largest
+  if it is not empty;
+* piece 1, {u < 0}: the window holds two roots (one solution in each aspect: the two
+  roots have opposite f' and the same sign of D); it holds the corner where u is smallest.
+
+A point of piece 1 moves, one coordinate at a time, towards the corner where u is
+smallest without leaving {u < 0}; so piece 1 is connected, and so is its trace on every
+face of R or on any axis-aligned rectangle in R (the same argument inside it).  Likewise
+piece 0 (proofs/lemma-window-fold.md).  A point is placed in a piece by its window count,
+certified at the point (:func:`intervalkin.solve.window_model.window_signature`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from intervalkin.core.errors import InputError
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import sign_label
+from intervalkin.solve.simple_roots import ReducedBoxes
+from intervalkin.solve.window_model import DET_SIGN, WindowModels, window_signature
+
+__all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "WindowFolds", "window_folds", "fold_piece", "extreme_corners"]
+
+#: Kinds of window-modelled boxes.
+OPEN, CLEAR, FOLD = 0, 1, 2
+#: What the two roots of a pair window add to a signature (count, n_wa1, n_wa2).
+PAIR = np.array([2, 1, 1], dtype=np.int64)
+#: Halvings of the critical pieces of a pair window before its slope signs are read.
+CRITICAL_HALVINGS = 1
+
+
+@dataclass(frozen=True, eq=False)
+class WindowFolds:
+    """The window-clear boxes and window folds among window-modelled boxes (rows of a :class:`WindowModels`).
+
+    kind : (n,) int8, :data:`CLEAR`, :data:`FOLD` or :data:`OPEN` (not modelled, or a cusp
+        window, or several pair windows, or a slope sign not certified).
+    window : (n,) int64, the pair window of a fold (an index into the models' windows), -1 elsewhere.
+    rising : (n, 3) int8, for a fold: +1 where u grows with rho_l, -1 where it falls; 0 elsewhere.
+    signature : (n, 2, 3) int64, (count, n_wa1, n_wa2) of piece 0 (the pair window empty) and of
+        piece 1 (two roots in it) of a fold; of the whole box (piece 0) of a clear box; -1 elsewhere.
+    """
+
+    kind: np.ndarray
+    window: np.ndarray
+    rising: np.ndarray
+    signature: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.kind)
+
+    def concat(self, other: "WindowFolds", windows: int) -> "WindowFolds":
+        """These rows followed by ``other``'s, whose window indices are shifted by ``windows``."""
+        shifted = np.where(other.window >= 0, other.window + windows, -1)
+        return WindowFolds(*(np.concatenate([a, b]) for a, b in (
+            (self.kind, other.kind), (self.window, shifted), (self.rising, other.rising),
+            (self.signature, other.signature))))
+
+
+def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITICAL_HALVINGS) -> WindowFolds:
+    """Classify the boxes of ``models`` and prove the slope signs of their pair windows (vectorised).
+
+    The slopes are needed only where the window's interior minimum of s f can sit: on the
+    *critical* pieces, where neither s f > 0 nor df/dphi != 0 is certified over R^2 x piece;
+    those are halved ``halvings`` times to tighten them.
+    """
+    n = len(models.ok)
+    w = len(models.degree)
+    ends = models.end_signs.astype(np.int64)
+    even = ends[:, 0] == ends[:, 1]
+    constant = (models.degree == 2) & ~even
+    cusp = (models.degree == 3) & ~even
+    box = models.window_box
+    n_pair = np.bincount(box, weights=even, minlength=n)
+    n_cusp = np.bincount(box, weights=cusp, minlength=n)
+    # the constant part of the signature: the roots off the windows and one root per constant window
+    rising_root = ends[:, 0] < 0
+    det_pos = constant & ((DET_SIGN * models.d_sign.astype(np.int64) * np.where(rising_root, 1, -1)) > 0)
+    base = models.off.copy()
+    base[:, 0] += np.bincount(box, weights=constant, minlength=n).astype(np.int64)
+    base[:, 1] += np.bincount(box, weights=det_pos, minlength=n).astype(np.int64)
+    base[:, 2] += np.bincount(box, weights=constant & ~det_pos, minlength=n).astype(np.int64)
+    kind = np.full(n, OPEN, dtype=np.int8)
+    clear = models.ok & (n_pair == 0) & (n_cusp == 0)
+    kind[clear] = CLEAR
+    candidate = models.ok & (n_pair == 1) & (n_cusp == 0)
+    window = np.full(n, -1, dtype=np.int64)
+    pair_w = np.flatnonzero(even & candidate[box])
+    window[box[pair_w]] = pair_w
+    rising = np.zeros((n, 3), dtype=np.int8)
+    if pair_w.size:
+        on = np.isin(models.piece_window, pair_w)
+        cand = np.flatnonzero(candidate)
+        row = np.full(n, -1, dtype=np.int64)
+        row[cand] = np.arange(cand.size)
+        rising[box[pair_w]] = _slopes(ReducedBoxes(geometry, models.boxes[cand]), row[box], ends[:, 0], w,
+                                      models.piece_window[on], models.piece_lo[on], models.piece_hi[on],
+                                      halvings)[pair_w]
+    fold = candidate & (rising != 0).all(axis=1)
+    kind[fold] = FOLD
+    window[~fold] = -1
+    rising[~fold] = 0
+    signature = np.full((n, 2, 3), -1, dtype=np.int64)
+    signature[clear, 0] = base[clear]
+    signature[fold, 0] = base[fold]
+    signature[fold, 1] = base[fold] + PAIR
+    return WindowFolds(kind, window, rising, signature)
+
+
+def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: int, pw: np.ndarray,
+            lo: np.ndarray, hi: np.ndarray, halvings: int) -> np.ndarray:
+    """(w, 3) int8 per window: the certified sign of s d f / d r_l on its critical pieces (0: not certified).
+
+    A window with no critical piece left has u > 0 on all of R (no root): every direction is
+    valid for it, and +1 is returned.
+    """
+    for round_ in range(halvings + 1):
+        owner = owner_of_window[pw]
+        crit = sign_label(data.enclosure(owner, lo, hi, 1)) == 0
+        if round_:  # a window's own pieces are the ones where f may vanish: s f > 0 shows only on halves
+            crit[crit] = sign_label(data.enclosure(owner[crit], lo[crit], hi[crit], 0))[...] * s[pw[crit]] <= 0
+        pw, lo, hi = pw[crit], lo[crit], hi[crit]
+        if round_ < halvings:
+            mid = np.minimum(np.maximum(0.5 * lo + 0.5 * hi, lo), hi)
+            pw, lo, hi = np.r_[pw, pw], np.r_[lo, mid], np.r_[mid, hi]
+    out = np.ones((w, 3), dtype=np.int8)
+    owner = owner_of_window[pw]
+    for axis in range(3):
+        sg = sign_label(data.r_slope(owner, lo, hi, axis)).astype(np.int64) * s[pw]
+        low = np.full(w, 2, dtype=np.int64)
+        high = np.full(w, -2, dtype=np.int64)
+        np.minimum.at(low, pw, sg)
+        np.maximum.at(high, pw, sg)
+        out[:, axis] = np.where(low == 2, 1, np.where((low == high) & (low != 0), low, 0))
+    return out
+
+
+def fold_piece(geometry: Geometry, models: WindowModels, folds: WindowFolds, rows: np.ndarray,
+               points: np.ndarray) -> np.ndarray:
+    """(m,) int8: the piece of each point (m, 3) of box ``rows`` (m,): 0 or 1 for a fold, 0 for a clear box;
+    -1 where the point's window count is not decided (on or very near g(S)) or the box is open.
+
+    Certified: a fold's piece is read from the count proved at the point; a clear box is off g(S).
+    """
+    rows = np.asarray(rows, dtype=np.int64)
+    q = np.asarray(points, dtype=np.float64)
+    if q.ndim != 2 or q.shape[1] != 3 or rows.shape != (len(q),):
+        raise InputError(f"points: expected shape (m, 3) and rows (m,), got {q.shape} and {rows.shape}")
+    out = np.full(len(rows), -1, dtype=np.int8)
+    kind = folds.kind[rows]
+    box = models.boxes[rows]
+    inside = ((box[:, :, 0] <= q) & (q <= box[:, :, 1])).all(axis=1)
+    if not inside.all():
+        raise InputError("points: every point must lie in its box models.boxes[rows]")
+    out[kind == CLEAR] = 0
+    at = np.flatnonzero(kind == FOLD)
+    if at.size:
+        count = window_signature(geometry, models, rows[at], q[at])[:, 0]
+        extra = count - folds.signature[rows[at], 0, 0]
+        out[at] = np.where(count < 0, -1, np.where(extra == 0, 0, np.where(extra == 2, 1, -1)))
+    return out
+
+
+def extreme_corners(lo: np.ndarray, hi: np.ndarray, rising: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(corner where u is smallest, corner where it is largest) of boxes or faces lo, hi (m, 3), for folds
+    with directions ``rising`` (m, 3): piece 1 holds the first if it is not empty, piece 0 the second."""
+    up = np.asarray(rising) > 0
+    return np.where(up, lo, hi), np.where(up, hi, lo)

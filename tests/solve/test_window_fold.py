@@ -1,0 +1,167 @@
+"""Window folds and window-clear boxes (solve.window_fold, proofs/lemma-window-fold.md).
+
+The boxes are the window-modelled leaves of the session's depth-5 joint paving (``fold_paving``).
+
+- the piece a point is placed in matches the roots of f counted at 50 digits in the pair window
+  (0 or 2), and the piece's signature is the certified solver's;
+- along random lines parallel to an axis the pair window's count changes at most once, from two
+  roots to none in the direction the model says u grows (down-set / up-set), and reversing the
+  directions is caught by the same check;
+- ``ReducedBoxes.r_slope`` encloses df/dr_l computed in arb (f is quadratic in r: a central
+  difference is exact).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from fractions import Fraction
+
+import mpmath
+import numpy as np
+import pytest
+from flint import arb, ctx, fmpq
+
+from intervalkin.kinematics.sextic import laurent_value, reduction
+from intervalkin.solve.simple_roots import ReducedBoxes
+from intervalkin.solve.window_fold import CLEAR, FOLD, extreme_corners, fold_piece
+from tests.solve.test_window_model import _f_mp, _roots_on_circle, _truth
+
+
+@pytest.fixture(scope="module")
+def windows(fold_paving):
+    w = fold_paving.windows
+    assert w is not None and w.folds is not None
+    return w
+
+
+def _points_in(windows, kind: int, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    rows = rng.choice(np.flatnonzero(windows.folds.kind == kind), n, replace=True)
+    b = windows.models.boxes[rows]
+    return rows, b[:, :, 0] + rng.uniform(size=(n, 3)) * (b[:, :, 1] - b[:, :, 0])
+
+
+def _window_roots(geometry, windows, w: int, rho: np.ndarray) -> int | None:
+    """Roots of f(.; rho^2) in window w, counted at 50 digits (None when one is too close to call)."""
+    mpmath.mp.dps = 50
+    roots = _roots_on_circle(_f_mp(geometry, rho))
+    if roots is None:
+        return None
+    m = windows.models
+    p = m.piece_window == w
+    inside = 0
+    for phi in roots:
+        inside += any(mpmath.mpf(float(lo)) <= phi <= mpmath.mpf(float(hi))
+                      or (mpmath.mpf(float(lo)) <= phi + 2 * mpmath.pi <= mpmath.mpf(float(hi)))
+                      or (mpmath.mpf(float(lo)) <= phi - 2 * mpmath.pi <= mpmath.mpf(float(hi)))
+                      for lo, hi in zip(m.piece_lo[p], m.piece_hi[p]))
+    return inside
+
+
+def test_folds_and_clear_boxes_are_found(windows):
+    kind = windows.folds.kind
+    assert np.count_nonzero(kind == FOLD) > 200 and np.count_nonzero(kind == CLEAR) > 50
+    assert np.all(np.abs(windows.folds.rising[kind == FOLD]) == 1)
+    assert np.all(windows.folds.signature[kind == FOLD, 1] - windows.folds.signature[kind == FOLD, 0] == [2, 1, 1])
+
+
+def test_piece_counts_agree_with_high_precision_roots(paper_geometry, windows):
+    """Random points of window folds: piece s holds exactly 2 s roots of f in the pair window (50 digits)."""
+    rows, points = _points_in(windows, FOLD, 80, 1)
+    piece = fold_piece(paper_geometry, windows.models, windows.folds, rows, points)
+    assert (piece >= 0).mean() > 0.9
+    checked = 0
+    for r, q, s in zip(rows, points, piece):
+        if s < 0:
+            continue
+        n = _window_roots(paper_geometry, windows, int(windows.folds.window[r]), q)
+        if n is None:
+            continue
+        assert n == 2 * s, (r, q, s, n)
+        checked += 1
+    assert checked >= 60
+    assert len(set(piece[piece >= 0])) == 2  # both pieces were sampled
+
+
+def test_piece_signatures_are_the_solvers(paper_geometry, windows):
+    """Points of window folds and window-clear boxes: the signature of their piece is the certified solver's."""
+    rows_f, pts_f = _points_in(windows, FOLD, 30, 2)
+    rows_c, pts_c = _points_in(windows, CLEAR, 15, 3)
+    rows, points = np.r_[rows_f, rows_c], np.concatenate([pts_f, pts_c])
+    piece = fold_piece(paper_geometry, windows.models, windows.folds, rows, points)
+    ok = piece >= 0
+    sig = windows.folds.signature[rows[ok], piece[ok]]
+    assert np.array_equal(sig, _truth(paper_geometry, points[ok]))
+    assert ok.sum() >= 40
+
+
+def _violations(geometry, windows, folds, lines: int, seed: int) -> tuple[int, int]:
+    """(lines whose piece sequence breaks the down-set / up-set rule, lines where the piece changes)."""
+    rng = np.random.default_rng(seed)
+    rows = rng.choice(np.flatnonzero(folds.kind == FOLD), lines)
+    axis = rng.integers(0, 3, lines)
+    b = windows.models.boxes[rows]
+    base = b[:, :, 0] + rng.uniform(size=(lines, 3)) * (b[:, :, 1] - b[:, :, 0])
+    t = np.linspace(0.0, 1.0, 9)
+    pts = np.repeat(base[:, None, :], len(t), axis=1)
+    idx = np.arange(lines)
+    pts[idx[:, None], np.arange(len(t))[None, :], axis[:, None]] = (b[idx, axis, 0][:, None]
+                                                                     + t[None, :] * (b[idx, axis, 1] - b[idx, axis, 0])[:, None])
+    piece = fold_piece(geometry, windows.models, folds, np.repeat(rows, len(t)), pts.reshape(-1, 3)).reshape(lines, -1)
+    bad = changing = 0
+    for line, k, r in zip(piece, axis, rows):
+        seq = line[line >= 0] if folds.rising[r, k] > 0 else line[line >= 0][::-1]
+        # in the direction where u grows the piece goes from 1 (two roots) to 0 (none), never back
+        changing += len(set(seq)) > 1
+        bad += bool(np.any(np.diff(seq.astype(int)) > 0))
+    return bad, changing
+
+
+def test_pieces_are_down_and_up_sets_along_every_axis(paper_geometry, windows):
+    bad, changing = _violations(paper_geometry, windows, windows.folds, 300, 4)
+    assert bad == 0 and changing >= 10
+
+
+def test_a_flipped_slope_is_caught(paper_geometry, windows):
+    """Directions reversed: the same lines break the rule, and the extreme corners land in the wrong pieces."""
+    flipped = dataclasses.replace(windows.folds, rising=(-windows.folds.rising).astype(np.int8))
+    bad, changing = _violations(paper_geometry, windows, flipped, 300, 4)
+    assert bad >= 10 and bad == changing
+    rows = np.flatnonzero(windows.folds.kind == FOLD)[:400]
+    b = windows.models.boxes[rows]
+    low, high = extreme_corners(b[:, :, 0], b[:, :, 1], windows.folds.rising[rows])
+    side_low = fold_piece(paper_geometry, windows.models, windows.folds, rows, low)
+    side_high = fold_piece(paper_geometry, windows.models, windows.folds, rows, high)
+    # the corner where u is smallest is in piece 1 whenever the corner where it is largest is
+    assert not np.any((side_high == 1) & (side_low == 0))
+    assert np.any((side_low == 1) & (side_high == 0))
+
+
+def test_r_slope_encloses_the_derivative(paper_geometry, windows):
+    """At random (r, phi) in pieces of pair windows, df/dr_l in arb lies in the enclosure over the piece."""
+    m, folds = windows.models, windows.folds
+    rng = np.random.default_rng(6)
+    rows = rng.choice(np.flatnonzero(folds.kind == FOLD), 40)
+    data = ReducedBoxes(paper_geometry, m.boxes[rows])
+    checked = 0
+    for i, r in enumerate(rows):
+        p = np.flatnonzero(m.piece_window == folds.window[r])
+        j = rng.choice(p)
+        lo, hi = m.piece_lo[j], m.piece_hi[j]
+        box = m.boxes[r]
+        rho = box[:, 0] + rng.uniform(size=3) * (box[:, 1] - box[:, 0])
+        phi = lo + rng.uniform() * (hi - lo)
+        for axis in range(3):
+            enc = data.r_slope(np.array([i]), np.array([lo]), np.array([hi]), axis)
+            with ctx.workprec(200):
+                rsq = [arb(fmpq(Fraction(float(v)).numerator ** 2, Fraction(float(v)).denominator ** 2)) for v in rho]
+                h = arb(1)
+                up, down = list(rsq), list(rsq)
+                up[axis] += h
+                down[axis] -= h
+                z = arb(fmpq(Fraction(float(phi)).numerator, Fraction(float(phi)).denominator))
+                d = (laurent_value(reduction(paper_geometry, up).f, z).real
+                     - laurent_value(reduction(paper_geometry, down).f, z).real) / 2
+                assert float(d.mid()) - float(d.rad()) >= enc.lo[0] and float(d.mid()) + float(d.rad()) <= enc.hi[0]
+            checked += 1
+    assert checked == 120
