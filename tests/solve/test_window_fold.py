@@ -61,7 +61,10 @@ def _window_roots(geometry, windows, w: int, rho: np.ndarray) -> int | None:
 def test_folds_and_clear_boxes_are_found(windows):
     kind = windows.folds.kind
     assert np.count_nonzero(kind == FOLD) > 200 and np.count_nonzero(kind == CLEAR) > 50
-    assert np.all(np.abs(windows.folds.rising[kind == FOLD]) == 1)
+    r, e = windows.folds.rising[kind == FOLD], windows.folds.edge_rising[kind == FOLD]
+    full = (r != 0).all(axis=1)
+    two = (np.count_nonzero(r, axis=1) == 2) & (e != 0).all(axis=1)
+    assert np.all(full | two) and not np.any(e[full]) and full.sum() > 100 and two.sum() > 20
     assert np.all(windows.folds.signature[kind == FOLD, 1] - windows.folds.signature[kind == FOLD, 0] == [2, 1, 1])
 
 
@@ -99,9 +102,16 @@ def _violations(geometry, windows, folds, lines: int, seed: int) -> tuple[int, i
     """(lines whose piece sequence breaks the down-set / up-set rule, lines where the piece changes)."""
     rng = np.random.default_rng(seed)
     rows = rng.choice(np.flatnonzero(folds.kind == FOLD), lines)
-    axis = rng.integers(0, 3, lines)
+    # an axis along which u is proved monotone on the whole box
+    axis = np.array([rng.choice(np.flatnonzero(folds.rising[r] != 0)) for r in rows])
     b = windows.models.boxes[rows]
     base = b[:, :, 0] + rng.uniform(size=(lines, 3)) * (b[:, :, 1] - b[:, :, 0])
+    return _along(geometry, windows, folds, rows, axis, base, folds.rising[rows, axis])
+
+
+def _along(geometry, windows, folds, rows, axis, base, direction) -> tuple[int, int]:
+    lines = len(rows)
+    b = windows.models.boxes[rows]
     t = np.linspace(0.0, 1.0, 9)
     pts = np.repeat(base[:, None, :], len(t), axis=1)
     idx = np.arange(lines)
@@ -109,8 +119,8 @@ def _violations(geometry, windows, folds, lines: int, seed: int) -> tuple[int, i
                                                                      + t[None, :] * (b[idx, axis, 1] - b[idx, axis, 0])[:, None])
     piece = fold_piece(geometry, windows.models, folds, np.repeat(rows, len(t)), pts.reshape(-1, 3)).reshape(lines, -1)
     bad = changing = 0
-    for line, k, r in zip(piece, axis, rows):
-        seq = line[line >= 0] if folds.rising[r, k] > 0 else line[line >= 0][::-1]
+    for line, d in zip(piece, direction):
+        seq = line[line >= 0] if d > 0 else line[line >= 0][::-1]
         # in the direction where u grows the piece goes from 1 (two roots) to 0 (none), never back
         changing += len(set(seq)) > 1
         bad += bool(np.any(np.diff(seq.astype(int)) > 0))
@@ -122,14 +132,34 @@ def test_pieces_are_down_and_up_sets_along_every_axis(paper_geometry, windows):
     assert bad == 0 and changing >= 10
 
 
+def test_two_axis_folds_are_monotone_on_their_edges(paper_geometry, windows):
+    """Two-axis folds: along the free axis, on the edge towards -rising (and towards +rising), the window's
+    count changes at most once in the direction of edge_rising; the extreme corners are ordered."""
+    folds = windows.folds
+    rows = np.flatnonzero((folds.kind == FOLD) & (folds.edge_rising != 0).all(axis=1))[:150]
+    free = np.argmin(np.abs(folds.rising[rows]), axis=1)
+    b = windows.models.boxes[rows]
+    bad = changing = 0
+    for end, toward in enumerate((-1, 1)):
+        base = np.where(folds.rising[rows] * toward > 0, b[:, :, 1], b[:, :, 0])
+        got = _along(paper_geometry, windows, folds, rows, free, base, folds.edge_rising[rows, end])
+        bad, changing = bad + got[0], changing + got[1]
+    assert bad == 0 and changing >= 5
+    low, high = extreme_corners(b[:, :, 0], b[:, :, 1], folds.rising[rows], folds.edge_rising[rows])
+    side_low = fold_piece(paper_geometry, windows.models, folds, rows, low)
+    side_high = fold_piece(paper_geometry, windows.models, folds, rows, high)
+    assert not np.any((side_high == 1) & (side_low == 0))
+
+
 def test_a_flipped_slope_is_caught(paper_geometry, windows):
     """Directions reversed: the same lines break the rule, and the extreme corners land in the wrong pieces."""
-    flipped = dataclasses.replace(windows.folds, rising=(-windows.folds.rising).astype(np.int8))
+    flipped = dataclasses.replace(windows.folds, rising=(-windows.folds.rising).astype(np.int8),
+                                  edge_rising=(-windows.folds.edge_rising).astype(np.int8))
     bad, changing = _violations(paper_geometry, windows, flipped, 300, 4)
     assert bad >= 10 and bad == changing
     rows = np.flatnonzero(windows.folds.kind == FOLD)[:400]
     b = windows.models.boxes[rows]
-    low, high = extreme_corners(b[:, :, 0], b[:, :, 1], windows.folds.rising[rows])
+    low, high = extreme_corners(b[:, :, 0], b[:, :, 1], windows.folds.rising[rows], windows.folds.edge_rising[rows])
     side_low = fold_piece(paper_geometry, windows.models, windows.folds, rows, low)
     side_high = fold_piece(paper_geometry, windows.models, windows.folds, rows, high)
     # the corner where u is smallest is in piece 1 whenever the corner where it is largest is

@@ -28,7 +28,9 @@ exactly in {u = 0}, and R minus g(S) is two pieces, each connected or empty:
 A point of piece 1 moves, one coordinate at a time, towards the corner where u is
 smallest without leaving {u < 0}; so piece 1 is connected, and so is its trace on every
 face of R or on any axis-aligned rectangle in R (the same argument inside it).  Likewise
-piece 0 (proofs/lemma-window-fold.md).  A point is placed in a piece by its window count,
+piece 0 (proofs/lemma-window-fold.md).  *Two-axis* folds: when the slope is certified
+for two axes only, it is checked along the third on two edges of R, and the pieces retract to
+those edges (statement 4' of the lemma).  A point is placed in a piece by its window count,
 certified at the point (:func:`intervalkin.solve.window_model.window_signature`).
 """
 
@@ -61,7 +63,11 @@ class WindowFolds:
     kind : (n,) int8, :data:`CLEAR`, :data:`FOLD` or :data:`OPEN` (not modelled, or a cusp
         window, or several pair windows, or a slope sign not certified).
     window : (n,) int64, the pair window of a fold (an index into the models' windows), -1 elsewhere.
-    rising : (n, 3) int8, for a fold: +1 where u grows with rho_l, -1 where it falls; 0 elsewhere.
+    rising : (n, 3) int8, for a fold: +1 where u grows with rho_l over the whole box, -1 where it
+        falls; 0 elsewhere, and on the free axis of a two-axis fold.
+    edge_rising : (n, 2) int8, for a two-axis fold: the same sign along its free axis a on the edge
+        E_low (the other two coordinates at their ends towards -rising) and on the edge E_high
+        (towards +rising); 0 elsewhere.
     signature : (n, 2, 3) int64, (count, n_wa1, n_wa2) of piece 0 (the pair window empty) and of
         piece 1 (two roots in it) of a fold; of the whole box (piece 0) of a clear box; -1 elsewhere.
     """
@@ -70,6 +76,7 @@ class WindowFolds:
     window: np.ndarray
     rising: np.ndarray
     signature: np.ndarray
+    edge_rising: np.ndarray
 
     def __len__(self) -> int:
         return len(self.kind)
@@ -79,7 +86,7 @@ class WindowFolds:
         shifted = np.where(other.window >= 0, other.window + windows, -1)
         return WindowFolds(*(np.concatenate([a, b]) for a, b in (
             (self.kind, other.kind), (self.window, shifted), (self.rising, other.rising),
-            (self.signature, other.signature))))
+            (self.signature, other.signature), (self.edge_rising, other.edge_rising))))
 
 
 def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITICAL_HALVINGS) -> WindowFolds:
@@ -121,15 +128,20 @@ def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITI
         rising[box[pair_w]] = _slopes(ReducedBoxes(geometry, models.boxes[cand]), row[box], ends[:, 0], w,
                                       models.piece_window[on], models.piece_lo[on], models.piece_hi[on],
                                       halvings)[pair_w]
-    fold = candidate & (rising != 0).all(axis=1)
+    edge_rising = np.zeros((n, 2), dtype=np.int8)
+    two = np.flatnonzero(candidate & (np.count_nonzero(rising, axis=1) == 2))
+    if two.size:
+        edge_rising[two] = _edge_slopes(geometry, models, two, rising[two], window[two], ends[:, 0], halvings)
+    fold = candidate & ((rising != 0).all(axis=1) | (edge_rising != 0).all(axis=1))
     kind[fold] = FOLD
+    edge_rising[~fold] = 0
     window[~fold] = -1
     rising[~fold] = 0
     signature = np.full((n, 2, 3), -1, dtype=np.int64)
     signature[clear, 0] = base[clear]
     signature[fold, 0] = base[fold]
     signature[fold, 1] = base[fold] + PAIR
-    return WindowFolds(kind, window, rising, signature)
+    return WindowFolds(kind, window, rising, signature, edge_rising)
 
 
 def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: int, pw: np.ndarray,
@@ -160,6 +172,29 @@ def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: i
     return out
 
 
+def _edge_slopes(geometry: Geometry, models: WindowModels, rows: np.ndarray, rising: np.ndarray, window: np.ndarray,
+                 s: np.ndarray, halvings: int) -> np.ndarray:
+    """(k, 2) int8: for boxes ``rows`` with one uncertified axis a, the certified sign of s df/dr_a over the
+    critical pieces of the pair window on the edges E_low and E_high (0: not certified)."""
+    box = models.boxes[rows]
+    free = np.argmin(np.abs(rising), axis=1)
+    k = len(rows)
+    out = np.zeros((k, 2), dtype=np.int8)
+    for end, toward in enumerate((-1, 1)):
+        edge = box.copy()
+        pin = np.where(rising * toward > 0, box[:, :, 1], box[:, :, 0])  # the end of each axis in that direction
+        fixed = np.arange(3)[None, :] != free[:, None]
+        edge[:, :, 0] = np.where(fixed, pin, box[:, :, 0])
+        edge[:, :, 1] = np.where(fixed, pin, box[:, :, 1])
+        owner = np.full(len(models.degree), -1, dtype=np.int64)
+        owner[window] = np.arange(k)
+        on = np.isin(models.piece_window, window)
+        signs = _slopes(ReducedBoxes(geometry, edge), owner, s, len(models.degree), models.piece_window[on],
+                        models.piece_lo[on], models.piece_hi[on], halvings)
+        out[:, end] = signs[window, free]
+    return out
+
+
 def fold_piece(geometry: Geometry, models: WindowModels, folds: WindowFolds, rows: np.ndarray,
                points: np.ndarray) -> np.ndarray:
     """(m,) int8: the piece of each point (m, 3) of box ``rows`` (m,): 0 or 1 for a fold, 0 for a clear box;
@@ -186,8 +221,16 @@ def fold_piece(geometry: Geometry, models: WindowModels, folds: WindowFolds, row
     return out
 
 
-def extreme_corners(lo: np.ndarray, hi: np.ndarray, rising: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def extreme_corners(lo: np.ndarray, hi: np.ndarray, rising: np.ndarray,
+                    edge_rising: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(corner where u is smallest, corner where it is largest) of boxes or faces lo, hi (m, 3), for folds
-    with directions ``rising`` (m, 3): piece 1 holds the first if it is not empty, piece 0 the second."""
-    up = np.asarray(rising) > 0
-    return np.where(up, lo, hi), np.where(up, hi, lo)
+    with directions ``rising`` (m, 3) and, for two-axis folds, ``edge_rising`` (m, 2) on their free axis:
+    piece 1 holds the first if it is not empty, piece 0 the second (on a face of a two-axis fold they
+    are only points to try)."""
+    rising = np.asarray(rising)
+    low_dir, high_dir = rising.copy(), rising.copy()
+    if edge_rising is not None:
+        free = rising == 0
+        low_dir = np.where(free, np.asarray(edge_rising)[:, :1], low_dir)
+        high_dir = np.where(free, np.asarray(edge_rising)[:, 1:], high_dir)
+    return np.where(low_dir > 0, lo, hi), np.where(high_dir > 0, hi, lo)

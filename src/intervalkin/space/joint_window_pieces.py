@@ -11,8 +11,9 @@ edge: joins may be missed, never invented.
 
 The points: each window fold places the two corners of the shared face where u is smallest
 and largest (piece 1 meets the face exactly when the first corner is in it, and piece 0 when
-the second is: u is monotone along every axis), so the edges between a window fold and a clear
-leaf, a window-clear leaf or another window fold are all found when those corners are decided.
+the second is, when u is monotone along every axis), so the edges between such a window fold and
+a clear leaf, a window-clear leaf or another such window fold are all found when those corners are
+decided.  For a two-axis fold (lemma, statement 4') they are points to try.
 The face centre is placed where no end is a window fold, or one end is a fold box (whose
 traces on a face need not be connected: edges there may be missed).  The corners of the leaf
 itself serve as witnesses.
@@ -102,7 +103,8 @@ def window_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.
     use = np.zeros(pts.shape[:2], dtype=bool)
     use[:, 0] = ~(fold_end[0] | fold_end[1]) | (frow[a] >= 0) | (frow[b] >= 0)
     for c, (e, is_fold) in enumerate(zip((a, b), fold_end)):
-        low, high = extreme_corners(flo, fhi, folds.rising[np.maximum(wrow[e], 0)])
+        low, high = extreme_corners(flo, fhi, folds.rising[np.maximum(wrow[e], 0)],
+                                    folds.edge_rising[np.maximum(wrow[e], 0)])
         pts[:, 1 + 2 * c], pts[:, 2 + 2 * c] = low, high
         use[is_fold, 1 + 2 * c:3 + 2 * c] = True
     q = pts[use]
@@ -134,7 +136,7 @@ def window_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.
     # the leaf's own extreme corners: in piece 1 and piece 0 when these are not empty
     j = np.flatnonzero(pieced)
     leaf = windows.leaf[j]
-    low, high = extreme_corners(lo[leaf], hi[leaf], folds.rising[j])
+    low, high = extreme_corners(lo[leaf], hi[leaf], folds.rising[j], folds.edge_rising[j])
     corner_rows = np.r_[j, j]
     corners = np.concatenate([low, high])
     side = window_sides(geometry, windows, corner_rows, corners, workers)
