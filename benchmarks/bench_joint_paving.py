@@ -146,6 +146,9 @@ def main() -> None:
             print(f"       window models: {w['leaves_modelled']} of {w['leaves_tried']} leaves without a fold model "
                   f"(volume {w['volume_modelled']:.1f} of {w['volume_tried']:.1f}); {w['pair_windows']} pair and "
                   f"{w['triple_windows']} triple windows; {w['seconds']:.1f} s", flush=True)
+            if "window_folds" in w:
+                print(f"       window pieces: {w['window_clear']} window-clear leaves and {w['window_folds']} window "
+                      f"folds (volume {w['volume_pieced']:.1f}), proved pieces joined to the cells", flush=True)
         print("       undecided volume per stage: " + ", ".join(
             f"{st['stage']} {st['level']}: {st['undecided_volume']['clear']:.0f}" for st in jp.paving.stats), flush=True)
         print("       cells: " + "; ".join(f"{c.count} ({c.n_wa1}+{c.n_wa2}) vol {c.volume:.2f} at "

@@ -90,3 +90,33 @@ def test_certified_share_grows_with_window_pieces(fold_paving):
     known = (fold_paving.cell >= 0) | fold_paving.counted_fold_mask()
     assert fold_paving.certified_share() > v[known].sum() / v.sum()
     assert np.isclose(fold_paving.certified_share(), v[known | fold_paving.pieced_mask()].sum() / v.sum())
+
+
+def test_npz_columns_of_window_pieces(fold_paving, paper_geometry):
+    """Window-clear leaves carry their signature; for window folds, where the counts the window model proves
+    near the bottom and the top of the leaf along fold_axis differ, they are count_below and count_above (so a
+    swapped orientation fails)."""
+    cols = fold_paving.columns()
+    w = fold_paving.windows
+    clear = w.leaf[w.folds.kind == CLEAR]
+    assert np.array_equal(cols["count"][clear], w.folds.signature[w.folds.kind == CLEAR, 0, 0])
+    rows = np.flatnonzero(w.folds.kind == FOLD)[:300]
+    leaf = w.leaf[rows]
+    k = cols["fold_axis"][leaf]
+    assert np.all((k >= 0) & (k <= 2))
+    lo, hi = fold_paving.paving.lo[leaf], fold_paving.paving.hi[leaf]
+    centre = 0.5 * (lo + hi)
+    idx = np.arange(len(leaf))
+    near = []
+    for f in (0.001, 0.999):
+        p = centre.copy()
+        p[idx, k] = lo[idx, k] + f * (hi[idx, k] - lo[idx, k])
+        near.append(fold_paving.signature_of(p, paper_geometry)[:, 0])
+    # the line crosses the sheet at most once, from the piece below to the piece above: where its two ends
+    # differ, they are (count_below, count_above); where they agree, the count is one of the two
+    crossed = (near[0] >= 0) & (near[1] >= 0) & (near[0] != near[1])
+    assert crossed.sum() > 30
+    assert np.array_equal(near[0][crossed], cols["count_below"][leaf][crossed])
+    assert np.array_equal(near[1][crossed], cols["count_above"][leaf][crossed])
+    same = (near[0] >= 0) & (near[0] == near[1])
+    assert np.all((near[0][same] == cols["count_below"][leaf][same]) | (near[0][same] == cols["count_above"][leaf][same]))

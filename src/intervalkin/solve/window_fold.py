@@ -11,7 +11,8 @@ d (2 or 3: at most d roots with multiplicity) and the end signs of f:
 * *pair*: the end signs agree (s = the common sign): 0 or 2 roots.  With
   u(r) = min over the window of s f(phi; r), the window holds two simple roots where
   u < 0, none where u > 0, and a double root (a point of g(S)) where u = 0;
-* *cusp*: d = 3 and the end signs differ: one or three roots (a cusp edge may pass).
+* *cusp*: d = 3 and the end signs differ: one or three roots (a cusp edge may pass); a window
+  whose end signs or sign of D are not proved for the whole box is treated like one (open).
 
 R is a *window-clear* box when it has no pair and no cusp window: every root is simple
 on all of R, so R lies off g(S) and its signature is the same everywhere.  R is a
@@ -99,9 +100,11 @@ def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITI
     n = len(models.ok)
     w = len(models.degree)
     ends = models.end_signs.astype(np.int64)
-    even = ends[:, 0] == ends[:, 1]
-    constant = (models.degree == 2) & ~even
-    cusp = (models.degree == 3) & ~even
+    # a window with an end sign or a sign of D not proved for the whole box is decided only at points
+    firm = (ends != 0).all(axis=1) & (models.d_sign != 0)
+    even = firm & (ends[:, 0] == ends[:, 1])
+    constant = firm & (models.degree == 2) & ~even
+    cusp = ~firm | ((models.degree == 3) & ~even)
     box = models.window_box
     n_pair = np.bincount(box, weights=even, minlength=n)
     n_cusp = np.bincount(box, weights=cusp, minlength=n)

@@ -33,7 +33,9 @@ proved empty.  A fold box counts as certified volume when each piece is known or
 
 Window models (:mod:`intervalkin.space.joint_windows`, with ``windows=True``): the undecided leaves left
 without a fold model get a certified count at each of their points, proved at the point
-(proofs/lemma-window-model.md); they are not cut into proved pieces, so they stay open for the counts.
+(proofs/lemma-window-model.md).  Those whose model shows no sheet (window-clear) or one sheet along
+which the model's minimum is monotone (window folds, proofs/lemma-window-fold.md) are cut into proved
+pieces that join the piece graph (:mod:`intervalkin.space.joint_window_pieces`); the others stay open.
 
 What is NOT claimed: two cells are not proved to be different components of the
 joint box minus g(S) (they may still join through undecided boxes), and undecided
@@ -61,9 +63,9 @@ from intervalkin.space.joint_leaves import adaptive_leaves, leaves_to_paving, re
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
 from intervalkin.space.joint_models import ModelStore
 from intervalkin.space.joint_pieces import FoldPieces, PieceSignatures, piece_signatures
-from intervalkin.space.joint_places import open_places
+from intervalkin.space.joint_places import WHY_OPEN, open_places
 from intervalkin.space.joint_window_pieces import (check_window_cells, signatures_from_windows, window_cell_of,
-                                                   window_pieces)
+                                                   window_columns, window_pieces)
 from intervalkin.space.joint_windows import JointWindows, joint_windows
 
 __all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain", "DEFAULT_JOINT_DEPTH", "JOIN_LEVELS", "MODEL_LEVELS"]
@@ -145,13 +147,7 @@ class JointSpacePaving:
                 "places": {"count": n, "volume_without_model": float(p.volume()[no_model].sum()),
                            "volume_window_model": float(p.volume()[windowed].sum()),
                            "volume_window_pieces": float(p.volume()[self.pieced_mask()].sum()),
-                           "why": "no model of any kind (volume_without_model, without_model): the Krawczyk test of "
-                                  "the singular four-bar system failed for every axis (near cusp edges and "
-                                  "crossings of g(S)) and the window model failed too; or a window model "
-                                  "(volume_window_model: a certified count at each point, but the leaf's pieces "
-                                  "are not proved connected: a cusp window, several pair windows, or a slope "
-                                  "sign not certified); or a fold box with a piece of unknown count; "
-                                  "window-clear leaves and window folds (volume_window_pieces) are not open",
+                           "why": WHY_OPEN,
                            "largest": [q.to_json() for q in largest]}}
 
     def pieced_mask(self) -> np.ndarray:
@@ -237,7 +233,8 @@ class JointSpacePaving:
         """npz columns: lo, hi, level, cell id, count, n_wa1, n_wa2 (-1 where undecided); and for fold
         boxes: fold_axis (the axis k of the sheet, -1 elsewhere), cell_below and cell_above (the cells of
         the pieces q_k < h and q_k > h, -1 elsewhere or unknown), count_below and count_above (their
-        certified counts, inferred where the piece has no cell; -1 where unknown)."""
+        certified counts, inferred where the piece has no cell; -1 where unknown); window-clear leaves
+        and window folds likewise (:func:`intervalkin.space.joint_window_pieces.window_columns`)."""
         count = np.full(len(self.cell), -1, dtype=np.int32)
         wa1, wa2 = count.copy(), count.copy()
         for c in self.cells + self.fragments:
@@ -252,10 +249,11 @@ class JointSpacePaving:
             if self.piece_signatures is not None:
                 n_below[self.pieces.box] = self.piece_signatures.signature[:, 0, 0]
                 n_above[self.pieces.box] = self.piece_signatures.signature[:, 1, 0]
-        return {"lo": self.paving.lo, "hi": self.paving.hi, "level": self.paving.level.astype(np.int32),
+        cols = {"lo": self.paving.lo, "hi": self.paving.hi, "level": self.paving.level.astype(np.int32),
                 "cell": self.cell.astype(np.int32), "count": count, "n_wa1": wa1, "n_wa2": wa2,
                 "fold_axis": axis, "cell_below": below, "cell_above": above,
                 "count_below": n_below, "count_above": n_above}
+        return cols if self.windows is None else window_columns(cols, self.windows, self.window_cell)
 
 
 def joint_domain(geometry: Geometry) -> np.ndarray:
@@ -285,10 +283,10 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     model_levels : with ``fold``, further levels in the leaves left without a model (split,
         re-tested, modelled again), the last step of the local refinement.
     windows : with ``fold``, give the leaves left without a model window models
-        (:mod:`intervalkin.space.joint_windows`): certified counts at their points.  On the paper's
-        manipulator at the default depth: 80265 of 107742 such leaves, 74 % of their volume, for
-        about 13 s more on two cores; off by default (they add point labels near cusps and crossings,
-        not cells; the paper run leaves them off to stay within two minutes).
+        (:mod:`intervalkin.space.joint_windows`): certified counts at their points, and proved
+        pieces for the window-clear leaves and window folds among them.  On the paper's manipulator
+        at the default depth: 80265 of 107742 such leaves, 74 % of their volume; off by default (the
+        paper run leaves them off to stay within two minutes).
     workers : processes (default: two on a machine with two cores or more, see
         :func:`intervalkin.core.workers.default_workers`); large steps are cut into parts
         computed at once, and the paving is the same bit for bit whatever the number.

@@ -26,8 +26,16 @@ from scipy.sparse.csgraph import connected_components
 
 from intervalkin.paving.adjacency import shares_face
 
-__all__ = ["OpenPlace", "open_places", "PLACES_LISTED"]
+__all__ = ["OpenPlace", "open_places", "PLACES_LISTED", "WHY_OPEN"]
 
+#: Why a leaf is open, as the ``places`` block of ``summary.json`` says it.
+WHY_OPEN = ("no model of any kind (volume_without_model, without_model): the Krawczyk test of "
+            "the singular four-bar system failed for every axis (near cusp edges and "
+            "crossings of g(S)) and the window model failed too; or a window model "
+            "(volume_window_model: a certified count at each point, but the leaf's pieces "
+            "are not proved connected: a cusp window, several pair windows, or a slope "
+            "sign not certified); or a fold box with a piece of unknown count; "
+            "window-clear leaves and window folds (volume_window_pieces) are not open")
 #: The largest places listed one by one (the totals cover all of them).
 PLACES_LISTED = 40
 

@@ -188,3 +188,31 @@ def window_cell_of(geometry: Geometry, windows: JointWindows, window_cell: np.nd
         ok = side >= 0
         out[has[ok]] = window_cell[2 * row[has[ok]] + side[ok]]
     return out
+
+
+def window_columns(columns: dict[str, np.ndarray], windows: JointWindows, window_cell: np.ndarray) -> dict:
+    """The npz columns with the window-pieced leaves filled in (a new dict; the arrays are copied).
+
+    A window-clear leaf gets its cell and signature like a clear box.  A window fold gets
+    ``fold_axis`` = the first axis along which its sheet is a graph (its slope proved on the
+    whole leaf), and the cells and counts of its pieces below (q_k < h) and above (q_k > h): below
+    is piece 1 (two roots in the pair window) when u grows with q_k, piece 0 otherwise.
+    """
+    out = {k: v.copy() for k, v in columns.items()}
+    folds = windows.folds
+    if folds is None or not len(window_cell):
+        return out
+    j = np.flatnonzero(folds.kind == CLEAR)
+    leaf = windows.leaf[j]
+    out["cell"][leaf] = window_cell[2 * j]
+    for c, name in enumerate(("count", "n_wa1", "n_wa2")):
+        out[name][leaf] = folds.signature[j, 0, c]
+    j = np.flatnonzero(folds.kind == FOLD)
+    leaf = windows.leaf[j]
+    k = np.argmax(folds.rising[j] != 0, axis=1)
+    below = (folds.rising[j, k] > 0).astype(np.int64)
+    out["fold_axis"][leaf] = k
+    out["cell_below"][leaf], out["cell_above"][leaf] = window_cell[2 * j + below], window_cell[2 * j + 1 - below]
+    out["count_below"][leaf] = folds.signature[j, below, 0]
+    out["count_above"][leaf] = folds.signature[j, 1 - below, 0]
+    return out
