@@ -105,6 +105,14 @@ class Ball:
         r = np.einsum("...k,...k->...", am, o.rad) + np.einsum("...k,...k->...", self.rad, bm + o.rad)
         return Ball(m, _safe(r, np.einsum("...k,...k->...", am, bm)))
 
+    def dot_rows(self, o: "Ball") -> "Ball":
+        """self (m, k) dotted with each row of o (m, j, k): a ball (m, j); the same bound as :meth:`dot`,
+        with explicit subscripts (several times faster than broadcasting for large m)."""
+        am, bm = np.abs(self.mid), np.abs(o.mid)
+        m = np.einsum("mk,mjk->mj", self.mid, o.mid)
+        r = np.einsum("mk,mjk->mj", am, o.rad) + np.einsum("mk,mjk->mj", self.rad, bm + o.rad)
+        return Ball(m, _safe(r, np.einsum("mk,mjk->mj", am, bm)))
+
     def matmul(self, c: "Ball") -> "Ball":
         """self (..., k) times the matrix c (k, j): a ball (..., j); k <= 64."""
         am, cm = np.abs(self.mid), np.abs(c.mid)

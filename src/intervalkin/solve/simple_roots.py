@@ -148,7 +148,7 @@ class ReducedBoxes:
         def over_r(w: Ball) -> Ball:
             if self.at_points:
                 return w.dot(self.values[owner])
-            t = Ball(w.mid[:, None, :], w.rad[:, None, :]).dot(taylor)  # (m, 4)
+            t = w.dot_rows(taylor)  # (m, 4)
             spread = np.einsum("mi,mi->m", np.abs(t.mid[:, 1:]) + t.rad[:, 1:], half)
             q = w.matmul(Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy()))  # (m, 6)
             bound = self.quad_bound[owner]
@@ -177,7 +177,7 @@ class ReducedBoxes:
         taylor = self.taylor[owner]
         half = self.half[owner]
         w = _basis(Ball.from_interval(Interval(lo, hi)), 0)
-        t = Ball(w.mid[:, None, :], w.rad[:, None, :]).dot(taylor)  # (m, 4)
+        t = w.dot_rows(taylor)  # (m, 4)
         q = w.matmul(Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy()))  # (m, 6)
         quad = [e for e in MONOMIALS if len(e) == 2]
         spread = np.zeros(len(owner))
