@@ -55,6 +55,13 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
                + (f", upper bound {br['upper']})" if br.get("upper") is not None else "; no upper bound is proved)")
                + ". Cells with equal counts are not yet proved to be different components of the joint box "
                "minus g(S), and undecided boxes could still join two of them or hide a small one.\n")
+    closed = (jc.get("closed_cells") or {}).get("closed") or []
+    if closed:
+        sig = {c["id"]: c["count"] for c in jc["cells"] + (jc.get("fragments") or [])}
+        out.append(f"Closed cells: {', '.join(f'{c} ({sig.get(c, -1)} solutions)' for c in closed)}. Each is proved to be "
+                   "a whole component of the joint box minus g(S): every face contact of its pieces is decided and "
+                   "leads back into it (proofs/lemma-closed-cell.md), so it is separated from every other cell. "
+                   "These separations are not yet in the certificates, and the lower bound above does not use them.\n")
     frags = jc.get("fragments") or []
     if frags:
         out.append(f"{len(frags)} fragment{'' if len(frags) == 1 else 's'} (certified islands inside the undecided layer, made only by the local "

@@ -14,6 +14,7 @@ import numpy as np
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 from intervalkin.pipeline import Analysis
+from intervalkin.space.joint_closure import closed_cells
 from intervalkin.space.joint_space import JointPaving
 
 __all__ = ['CERTIFIED_NOTE', 'pave_summary', 'pave_table', 'joint_summary', 'joint_table', 'chain_summary', 'chain_table']
@@ -106,8 +107,9 @@ def joint_summary(jp: JointPaving) -> dict:
     }
 
 
-def joint_cells_summary(jp) -> dict:
-    """The direct joint paving: its resolution, certified share, cells (each with its certified count) and levels."""
+def joint_cells_summary(jp, geometry=None) -> dict:
+    """The direct joint paving: its resolution, certified share, cells (each with its certified count) and levels;
+    with ``geometry``, the cells proved closed (whole components; :mod:`intervalkin.space.joint_closure`)."""
     stats = jp.paving.stats
     uniform = [st for st in stats if st["stage"] == "joint paving"]
     fs = jp.fold_stats
@@ -133,12 +135,13 @@ def joint_cells_summary(jp) -> dict:
         "empty_pieces": int(fs.get("empty_pieces", 0)),
         "window_models": dict(fs.get("windows", {})),
         "open_places": jp.open_places()["places"],
+        **({} if geometry is None else {"closed_cells": closed_cells(jp, geometry).to_json()}),
         "certified": "every box of a cell is proved off g(S) (no singular pose has its joint vector in it: by the "
                      "torus search or by Krawczyk exclusion), or is a fold box: one sheet of g(S) crosses it as a "
                      "certified graph and each of its two pieces is joined to the cell through a point placed in "
                      "both; each cell's count and aspect split come from one complete certified solve at its "
                      "witness and hold at every point of the cell; cells are not proved to be different "
-                     "components; fragments are certified islands inside the undecided layer, made only by the "
+                     "components, except the closed cells (closed_cells: each is a whole component); fragments are certified islands inside the undecided layer, made only by the "
                      "local refinement and touching no face of the joint box: each lies in some component but is "
                      "not joined to one, so they are listed, not counted; fold pieces joined to no clear box are "
                      "counted under unjoined_fold_pieces and get their count from the other piece of their box "
@@ -165,7 +168,7 @@ def chain_summary(a: Analysis) -> dict:
             "WA2": {"boxes": p.count_by_label("WA2"), "volume": p.volume_by_label("WA2")},
             "aspect_components": list(ra.aspect_info),
             "joint": joint_summary(a.joint),
-            "joint_cells": joint_cells_summary(a.cells),
+            "joint_cells": joint_cells_summary(a.cells, a.geometry),
             "basic_region_list": [r.to_json() for r in ra.regions],
             "uniqueness_domain_list": [list(g) for g in ra.domains],
             "consistency": list(ra.consistency),
