@@ -12,12 +12,17 @@ certified for all r in R^2 split the circle into *arcs*:
 * an arc of monotone pieces (one sign s of df/dphi) holds exactly one root, simple, when
   the signs of f at its ends differ, and none otherwise; the root has D != 0 and the
   sign of det A is DET_SIGN * sign(D) * s (proofs/lemma-window-model.md);
-* an arc with an open piece is a *window* [a, b].  On it D != 0 and the d-th
-  phi-derivative of f has one strict sign over R^2 x [a, b], d = 2 (a pair window) or
-  d = 3 (a triple window): by Rolle f(.; r) has at most d roots in [a, b] counted with
-  multiplicity, for every r, and their number has the parity of [sign f(a) != sign f(b)].
+* an arc with an open piece is a *window* [a, b].  On it the d-th phi-derivative of f
+  has one strict sign over R^2 x [a, b], d = 2 (a pair window) or d = 3 (a triple
+  window): by Rolle f(.; r) has at most d roots in [a, b] counted with multiplicity, for
+  every r, and their number has the parity of [sign f(a) != sign f(b)].  D != 0 on it
+  (*box-wide*), or D may vanish there (*D-open*: the sign of D at each root is proved at
+  the point);
+* a window where neither holds is cut into *sub-windows*, runs of pieces sharing one
+  signed derivative of order 1, 2 or 3 (:mod:`intervalkin.solve.window_split`); the sign
+  of f at a cut between two of them is proved at the point.
 
-A box is modelled (``ok``) when every window is a pair or a triple window.  Then the
+A box is modelled (``ok``) when every window is modelled so.  Then the
 roots off the windows, their number and their det A signs, are the same for every r in
 R (:attr:`WindowModels.off`), and the signature at a point q of R is that plus the roots
 in each window at q, counted by :func:`window_signature` from certified signs of f(.; q).
@@ -34,12 +39,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from intervalkin.core.ball import Ball, cos_sin_multiple
 from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.interval import PI_HI, PI_LO, Interval, sign_label
-from intervalkin.kinematics.reduced_equation import denominator
+from intervalkin.core.interval import PI_HI, PI_LO, sign_label
 from intervalkin.solve.simple_roots import PIECES, ReducedBoxes, initial_pieces
+from intervalkin.solve.window_split import cut_at_d_zeros, denominator_enclosure, root_d_signs, sign_changes, sub_windows
 
 __all__ = ["WindowModels", "window_models", "window_signature", "denominator_enclosure", "DET_SIGN",
            "WINDOW_HALVINGS", "DEGREE_HALVINGS", "POINT_HALVINGS"]
@@ -58,6 +62,8 @@ POINT_HALVINGS = 18
 _CHUNK = 4096
 #: Pieces narrower than this are not bisected further.
 _MIN_WIDTH = 2.0**-30
+#: A (point, window) pair with more open sub-pieces than this is left undecided.
+_CROWD = 64
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,14 +73,17 @@ class WindowModels:
     Attributes
     ----------
     boxes : (n, 3, 2) the joint boxes R.
-    ok : (n,) bool, every window of the box is a pair or a triple window (and the roots off
-        the windows have certified det A signs).
+    ok : (n,) bool, every window of the box is modelled (and the roots off the windows have
+        certified det A signs).
     off : (n, 3) int64, (count, n_wa1, n_wa2) of the roots off the windows, the same for every
         point of the box (-1 where not ok).
     window_box : (w,) int64, the box of each window (sorted; windows of boxes not ok are dropped).
-    degree : (w,) int8, 2 or 3: the bound on the roots in the window, with multiplicity.
-    end_signs : (w, 2) int8, certified sign of f at the window's first and last cut, for all r in R^2.
-    d_sign : (w,) int8, the sign of D on the window.
+    degree : (w,) int8, 2 or 3 (1 to 3 for a sub-window): the bound on the roots in the window,
+        with multiplicity.
+    end_signs : (w, 2) int8, certified sign of f at the window's first and last cut, for all r in
+        R^2; 0 at an inner cut of a sub-window (the sign is proved at each point).
+    d_sign : (w,) int8, the sign of D on the window; 0 where it is not proved (a D-open window, or
+        a sub-window: the sign of D is proved at each root, at the point).
     piece_window, piece_lo, piece_hi : (p,) the pieces of each window in circle order (a window
         may run across phi = pi: its pieces then end at PI_HI and restart at -PI_HI).
     """
@@ -100,25 +109,14 @@ class WindowModels:
             (self.piece_window, other.piece_window + w), (self.piece_lo, other.piece_lo),
             (self.piece_hi, other.piece_hi))))
 
+    def box_wide(self) -> np.ndarray:
+        """(w,) bool: windows whose end signs and sign of D hold over the whole box (non-zero)."""
+        return (self.d_sign != 0) & np.all(self.end_signs != 0, axis=1)
+
     def windows_of(self, box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(first window, number of windows) of each box index in ``box``."""
         start = np.searchsorted(self.window_box, box, side="left")
         return start, np.searchsorted(self.window_box, box, side="right") - start
-
-
-def denominator_enclosure(geometry: Geometry, lo: np.ndarray, hi: np.ndarray) -> Interval:
-    """Enclosure of D(phi) = d_0 + d_1 cos phi + d_2 sin phi over [lo, hi] (mean value form and natural form)."""
-    d = Ball.from_interval(denominator(geometry))
-    piece = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
-
-    def value(phi: Ball, deriv: int) -> Ball:
-        c, s = cos_sin_multiple(phi, 1, deriv)  # deriv 1: (-sin, cos), and d_0 drops out
-        trig = d[1] * c + d[2] * s
-        return trig + d[0] if deriv == 0 else trig
-
-    at_mid = value(Ball.point(piece.mid), 0)
-    mv = (at_mid + value(piece, 1) * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
-    return mv.intersect(value(piece, 0).to_interval())
 
 
 def _node(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -161,22 +159,23 @@ def _uniform(values: np.ndarray, group: np.ndarray, n: int) -> np.ndarray:
     return np.where((lo == hi) & (lo != 0), lo, 0)
 
 
-def _degree(geometry: Geometry, data: ReducedBoxes, box: np.ndarray, window: np.ndarray, lo: np.ndarray,
-            hi: np.ndarray, d: int, n_windows: int, halvings: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per window: the one strict sign of the d-th derivative of f over it, and of D (0: not proved)."""
+def _degree(geometry: Geometry, data: ReducedBoxes, box: np.ndarray, group: np.ndarray, lo: np.ndarray,
+            hi: np.ndarray, d: int, n_groups: int, halvings: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per group of pieces (on box ``box[group]``): the one strict sign of the d-th derivative of f over
+    it, and of D (0: not proved)."""
     parts_w, parts_f, parts_d = [], [], []
     for round_ in range(halvings + 1):
-        sf = sign_label(data.enclosure(box[window], lo, hi, d))
+        sf = sign_label(data.enclosure(box[group], lo, hi, d))
         sd = sign_label(denominator_enclosure(geometry, lo, hi))
         stop = ((sf != 0) & (sd != 0)) | (hi - lo < _MIN_WIDTH) | (round_ == halvings)
-        parts_w.append(window[stop]), parts_f.append(sf[stop]), parts_d.append(sd[stop])
-        window, lo, hi = window[~stop], lo[~stop], hi[~stop]
-        if window.size == 0:
+        parts_w.append(group[stop]), parts_f.append(sf[stop]), parts_d.append(sd[stop])
+        group, lo, hi = group[~stop], lo[~stop], hi[~stop]
+        if group.size == 0:
             break
         mid = np.minimum(np.maximum(0.5 * lo + 0.5 * hi, lo), hi)
-        window, lo, hi = np.concatenate([window, window]), np.concatenate([lo, mid]), np.concatenate([mid, hi])
+        group, lo, hi = np.concatenate([group, group]), np.concatenate([lo, mid]), np.concatenate([mid, hi])
     w = np.concatenate(parts_w)
-    return _uniform(np.concatenate(parts_f), w, n_windows), _uniform(np.concatenate(parts_d), w, n_windows)
+    return _uniform(np.concatenate(parts_f), w, n_groups), _uniform(np.concatenate(parts_d), w, n_groups)
 
 
 def window_models(geometry: Geometry, boxes: np.ndarray, pieces: int = PIECES, halvings: int = WINDOW_HALVINGS,
@@ -263,23 +262,39 @@ def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, de
     wmap[win_arc] = np.arange(n_win)
     sel = np.flatnonzero(wmap[arc] >= 0)
     pw, plo, phi = wmap[arc[sel]], lo[sel], hi[sel]
-    wbox = arc_box[win_arc]
-    f2, d2 = _degree(geometry, data, wbox, pw, plo, phi, 2, n_win, degree_halvings)
+    wbox, n_p = arc_box[win_arc], pw.size
+    f2p, d2p = _degree(geometry, data, wbox[pw], np.arange(n_p), plo, phi, 2, n_p, degree_halvings)
+    f2, d2 = _uniform(f2p, pw, n_win), _uniform(d2p, pw, n_win)
     pair = (f2 != 0) & (d2 != 0)
-    rest = ~pair[pw]
-    f3, d3 = _degree(geometry, data, wbox, pw[rest], plo[rest], phi[rest], 3, n_win, degree_halvings)
+    rest = np.flatnonzero(~pair[pw])
+    f3p, d3p = _degree(geometry, data, wbox[pw], rest, plo[rest], phi[rest], 3, n_p, degree_halvings)
+    f3, d3 = _uniform(f3p[rest], pw[rest], n_win), _uniform(d3p[rest], pw[rest], n_win)
     triple = ~pair & (f3 != 0) & (d3 != 0)
-    degree = np.where(pair, 2, np.where(triple, 3, 0)).astype(np.int8)
-    d_sign = np.where(pair, d2, d3).astype(np.int8)
-    bad = np.bincount(arc_box, weights=bad_arc, minlength=n) + np.bincount(wbox, weights=degree == 0, minlength=n)
+    # D-open windows (d_sign 0 unless the other pass proved it), then the rest cut into sub-windows
+    loose = ~pair & ~triple
+    degree = np.select([pair, triple, loose & (f2 != 0), loose & (f3 != 0)], [2, 3, 2, 3], 0)
+    d_sign = np.select([pair, triple], [d2, d3], np.where(d2 != 0, d2, d3))
+    w_first, w_last = np.r_[True, pw[1:] != pw[:-1]], np.r_[pw[1:] != pw[:-1], True]
+    split = np.flatnonzero(degree[pw] == 0)
+    starts, order, failed = sub_windows(pw[split], np.stack([np.where(kind[sel] == 1, sign[sel], 0), f2p, f3p])[:, split])
+    run_start, p_degree = w_first.copy(), degree[pw]
+    run_start[split] |= starts
+    p_degree[split] = order
+    run = np.cumsum(run_start) - 1
+    first = np.flatnonzero(run_start)
+    last = np.r_[first[1:], n_p][:first.size] - 1
+    rw = pw[first]
+    run_d = np.where(degree[rw] > 0, d_sign[rw], _uniform(np.where(d2p != 0, d2p, d3p), run, first.size))
+    ends = np.stack([np.where(w_first[first], s_start[win_arc[rw]], 0), np.where(w_last[last], s_end[win_arc[rw]], 0)], axis=1)
+    bad = np.bincount(arc_box, weights=bad_arc, minlength=n) + np.bincount(wbox[pw[split]], weights=failed, minlength=n)
     ok = has_break & (bad == 0)
     off[~ok] = -1
-    wk = ok[wbox]
-    pk = wk[pw]
-    renumber = np.cumsum(wk) - 1
-    return WindowModels(boxes, ok, off, wbox[wk], degree[wk],
-                        np.stack([s_start[win_arc], s_end[win_arc]], axis=1)[wk].astype(np.int8), d_sign[wk],
-                        renumber[pw[pk]], plo[pk], phi[pk])
+    rk = ok[wbox[rw]]
+    renumber = np.cumsum(rk) - 1
+    pk = rk[run]
+    piece_window, piece_lo, piece_hi = cut_at_d_zeros(geometry, renumber[run[pk]], plo[pk], phi[pk], run_d[rk] == 0)
+    return WindowModels(boxes, ok, off, wbox[rw[rk]], p_degree[first[rk]].astype(np.int8), ends[rk].astype(np.int8),
+                        run_d[rk].astype(np.int8), piece_window, piece_lo, piece_hi)
 
 
 def window_signature(geometry: Geometry, models: WindowModels, rows: np.ndarray, points: np.ndarray,
@@ -288,11 +303,13 @@ def window_signature(geometry: Geometry, models: WindowModels, rows: np.ndarray,
 
     ``rows`` (m,) names the box of ``models`` that holds each point.  In each window the signs of
     f(.; q) (r = q^2 an interval) are proved at cut points, bisected where needed: k sign changes
-    prove at least k roots; with k >= degree - 1 the degree and the parity prove exactly k, all
-    simple; otherwise every sub-piece must show f != 0, or df/dphi != 0 with certified end signs.
-    A root where f rises has det A of sign DET_SIGN * sign(D); where it falls, the other sign.
-    Undecided: boxes not modelled, points on or very near g(S) (a multiple root), and (never
-    when the model is sound) more sign changes than the degree or a sign at q against the model's.
+    prove at least k roots; with k = degree, or k = degree - 1 and both end signs proved (at q
+    for an end sign 0), the degree and the parity prove exactly k, all simple; otherwise every
+    sub-piece must show f != 0, or df/dphi != 0 with certified end signs.  A root where f rises
+    has det A of sign DET_SIGN * sign(D); where it falls, the other sign (d_sign 0: sign(D) proved
+    on the root's bracket).  Undecided: boxes not modelled, points on or very near g(S) (a
+    multiple root), a root's bracket where D's sign is not proved, and (never when the model is
+    sound) more sign changes than the degree or a sign at q against the model's.
     """
     rows = np.asarray(rows, dtype=np.int64)
     q = np.asarray(points, dtype=np.float64)
@@ -320,12 +337,14 @@ def window_signature(geometry: Geometry, models: WindowModels, rows: np.ndarray,
     s0, s1 = node_sign(pair, lo), node_sign(pair, hi)
     head = np.r_[True, pair[1:] != pair[:-1]]
     tail = np.r_[pair[1:] != pair[:-1], True]
-    s0[head], s1[tail] = models.end_signs[win[pair[head]], 0], models.end_signs[win[pair[tail]], 1]
+    e0, e1 = models.end_signs[win[pair[head]], 0], models.end_signs[win[pair[tail]], 1]
+    s0[head], s1[tail] = np.where(e0 != 0, e0, s0[head]), np.where(e1 != 0, e1, s1[tail])  # 0: proved at q
     done = np.zeros(pt.size, dtype=bool)
     result = np.full((pt.size, 2), -1, dtype=np.int64)  # (roots, roots with det A > 0)
     fixed = np.zeros(pair.size, dtype=bool)  # sub-piece proved: f != 0, or monotone with certified end signs
     degree = models.degree[win].astype(np.int64)
     rising = DET_SIGN * models.d_sign[win] > 0
+    d_open = models.d_sign[win] == 0
     for round_ in range(halvings + 1):
         order = np.lexsort((lo, piece, pair))
         pair, piece, lo, hi, s0, s1, fixed = (a[order] for a in (pair, piece, lo, hi, s0, s1, fixed))
@@ -339,14 +358,25 @@ def window_signature(geometry: Geometry, models: WindowModels, rows: np.ndarray,
         sd = sign_label(data.enclosure(pt[pair[open_[mono]]], lo[open_[mono]], hi[open_[mono]], 1))
         fixed[open_] = sf != 0
         fixed[open_[mono]] = (sd != 0) & (s0[open_[mono]] != 0) & (s1[open_[mono]] != 0)
-        k, up = _changes(pair, s0, s1, pt.size)
-        whole = np.bincount(pair, weights=~fixed, minlength=pt.size) == 0
-        # at most `degree` roots with multiplicity, of the parity of k: k >= degree - 1 leaves only k
-        now = ~done & ~clash & (k <= degree) & ((k >= degree - 1) | whole)
-        result[now] = np.stack([k, np.where(rising, up, k - up)], axis=1)[now]
+        at, left, right, up_ = sign_changes(pair, lo, hi, s0, s1)
+        k, up = np.bincount(at, minlength=pt.size), np.bincount(at, weights=up_, minlength=pt.size).astype(np.int64)
+        unfixed = np.bincount(pair, weights=~fixed, minlength=pt.size)
+        whole = unfixed == 0
+        first, last = np.r_[True, pair[1:] != pair[:-1]], np.r_[pair[1:] != pair[:-1], True]
+        known = np.zeros(pt.size, dtype=bool)  # both end signs of the window proved (at q, for an end sign 0)
+        known[pair[first]] = (s0[first] != 0) & (s1[last] != 0)
+        # at most `degree` roots with multiplicity, of the parity of the end signs: k = degree - 1 leaves only k
+        now = ~done & ~clash & (k <= degree) & ((k == degree) | ((k == degree - 1) & known) | whole)
+        # where D may vanish on the window: the sign of D proved on the bracket of each (simple) root
+        roots = np.flatnonzero((now & d_open)[at])
+        d_root = root_d_signs(geometry, left[roots], right[roots])
+        now &= np.bincount(at[roots], weights=d_root == 0, minlength=pt.size) == 0
+        pos = np.bincount(at[roots], weights=DET_SIGN * d_root * np.where(up_[roots], 1, -1) > 0, minlength=pt.size)
+        result[now] = np.stack([k, np.where(d_open, pos, np.where(rising, up, k - up))], axis=1)[now]
         refuse = ~done & ((k > degree) | clash)  # more changes than the degree allows, or a clash: never if sound
         result[refuse] = -1
-        done |= now | refuse
+        crowd = ~done & ~now & (unfixed > _CROWD)  # on a multiple root, where the open sub-pieces double each round
+        done |= now | refuse | crowd
         drop = done[pair]
         pair, piece, lo, hi, s0, s1, fixed = (a[~drop] for a in (pair, piece, lo, hi, s0, s1, fixed))
         if pair.size == 0 or round_ == halvings:
@@ -365,14 +395,3 @@ def window_signature(geometry: Geometry, models: WindowModels, rows: np.ndarray,
     sig = models.off[rows[live]] + np.stack([total[:, 0], total[:, 1], total[:, 0] - total[:, 1]], axis=1).astype(np.int64)
     out[live[good]] = sig[good]
     return out
-
-
-def _changes(pair: np.ndarray, s0: np.ndarray, s1: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per pair: the sign changes of f along its sub-pieces (sorted), and how many of them rise."""
-    seq = np.stack([s0, s1], axis=1).ravel()
-    grp = np.repeat(pair, 2)
-    nz = seq != 0
-    v, g = seq[nz], grp[nz]
-    change = (v[1:] != v[:-1]) & (g[1:] == g[:-1])
-    return (np.bincount(g[1:][change], minlength=n),
-            np.bincount(g[1:][change & (v[1:] > 0)], minlength=n))

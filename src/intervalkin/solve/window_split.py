@@ -1,0 +1,151 @@
+"""Windows whose D sign or inner end signs are proved at the point (proofs/lemma-window-model.md, 2' and 4').
+
+Two kinds of windows of :mod:`intervalkin.solve.window_model` are not certified over the whole box:
+
+* *D-open windows*: the 2nd or 3rd phi-derivative of f has one strict sign on the window, but D
+  may vanish there (``d_sign`` 0).  Rolle's bound does not need D != 0; at a point, each simple
+  root counted in the window gets the sign of D proved on the bracket that holds it alone
+  (:func:`root_d_signs`).  The window's pieces are cut at phi_D +- :data:`D_GAP` (phi_D a zero
+  of D, independent of r), so that a bracket seldom holds phi_D.
+* *sub-windows*: neither derivative has one sign on the window, but each piece has a signed
+  f', f'' or f''' of its own.  The window is cut into maximal runs of pieces sharing one signed
+  derivative of order 1, 2 or 3 (:func:`sub_windows`): at most 1, 2 or 3 roots each.  The sign
+  of f at a cut between two runs holds for no certified part of the box (``end_signs`` 0 there)
+  and is proved at the point.
+
+Everything here is vectorised over windows, pieces and brackets.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from intervalkin.core.ball import Ball, cos_sin_multiple
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import PI_HI, Interval, sign_label
+from intervalkin.kinematics.reduced_equation import denominator
+
+__all__ = ["denominator_enclosure", "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
+
+#: Half-width of the gap cut around each zero of D in a D-open window.
+D_GAP = 1e-9
+#: Bisections of a root's bracket while proving the sign of D on it.
+D_HALVINGS = 12
+
+
+def denominator_enclosure(geometry: Geometry, lo: np.ndarray, hi: np.ndarray) -> Interval:
+    """Enclosure of D(phi) = d_0 + d_1 cos phi + d_2 sin phi over [lo, hi] (mean value form and natural form)."""
+    d = Ball.from_interval(denominator(geometry))
+    piece = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
+
+    def value(phi: Ball, deriv: int) -> Ball:
+        c, s = cos_sin_multiple(phi, 1, deriv)  # deriv 1: (-sin, cos), and d_0 drops out
+        trig = d[1] * c + d[2] * s
+        return trig + d[0] if deriv == 0 else trig
+
+    at_mid = value(Ball.point(piece.mid), 0)
+    mv = (at_mid + value(piece, 1) * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
+    return mv.intersect(value(piece, 0).to_interval())
+
+
+def d_zeros(geometry: Geometry) -> np.ndarray:
+    """The zeros of D(phi) = d_0 + d_1 cos phi + d_2 sin phi in (-pi, pi), in floats (used only as cut points)."""
+    d = denominator(geometry).mid()
+    amp = float(np.hypot(d[1], d[2]))
+    if not amp > abs(d[0]):
+        return np.zeros(0)
+    z = np.arctan2(d[2], d[1]) + np.array([-1.0, 1.0]) * np.arccos(-d[0] / amp)
+    return np.sort((z + np.pi) % (2 * np.pi) - np.pi)
+
+
+def cut_at_d_zeros(geometry: Geometry, window: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                   selected: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pieces (window, lo, hi) in order, those of the ``selected`` (w,) windows cut at phi_D +- D_GAP."""
+    cuts = np.sort(np.ravel(d_zeros(geometry)[:, None] + np.array([-D_GAP, D_GAP])))
+    cuts = cuts[np.abs(cuts) < PI_HI]
+    inside = selected[window][:, None] & (lo[:, None] < cuts) & (cuts < hi[:, None])
+    if not inside.any():
+        return window, lo, hi
+    c = np.broadcast_to(cuts, inside.shape)
+    start = np.concatenate([lo[:, None], np.where(inside, c, np.nan)], axis=1).ravel()
+    end = np.concatenate([np.where(inside, c, np.nan), hi[:, None]], axis=1).ravel()
+    keep_s, keep_e = ~np.isnan(start), ~np.isnan(end)
+    return np.repeat(window, 1 + inside.sum(axis=1)), start[keep_s], end[keep_e]
+
+
+def sub_windows(window: np.ndarray, channels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Greedy maximal runs of pieces sharing one signed derivative.
+
+    ``window`` (p,) sorted: the window of each piece (pieces in circle order); ``channels`` (3, p):
+    the certified sign of f', f'', f''' over each piece (0: not proved).  Returns ``start`` (p,) bool,
+    the first piece of each run; ``order`` (p,) int8, at a run's first piece the lowest order whose
+    sign is shared by the whole run (0 elsewhere); ``failed`` (p,) bool, True on every piece of a
+    window with a piece of no signed derivative.
+    """
+    p = window.size
+    start, order = np.zeros(p, dtype=bool), np.zeros(p, dtype=np.int8)
+    if p == 0:
+        return start, order, np.zeros(0, dtype=bool)
+    reach = np.full((3, p), -1, dtype=np.int64)  # last piece of the run of one sign of f^(d) through each piece
+    for d in range(3):
+        c = channels[d]
+        new = np.r_[True, (c[1:] != c[:-1]) | (window[1:] != window[:-1])]
+        last = np.r_[np.flatnonzero(new)[1:] - 1, p - 1][np.cumsum(new) - 1]
+        reach[d] = np.where(c != 0, last, -1)
+    far = reach.max(axis=0)
+    first = np.flatnonzero(np.r_[True, window[1:] != window[:-1]])
+    final = np.r_[first[1:] - 1, p - 1]
+    bad = np.zeros(first.size, dtype=bool)
+    cur, live = first.copy(), np.arange(first.size)
+    while live.size:  # one run per window and step: as many steps as the longest window has runs
+        s = cur[live]
+        e = far[s]
+        bad[live[e < s]] = True
+        ok = e >= s
+        live, s, e = live[ok], s[ok], e[ok]
+        start[s] = True
+        order[s] = 1 + np.argmax(reach[:, s] >= e, axis=0)
+        cur[live] = e + 1
+        live = live[cur[live] <= final[live]]
+    return start, order, np.repeat(bad, np.diff(np.r_[first, p]))
+
+
+def _bracket_d_signs(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, owner: np.ndarray, n: int,
+                     halvings: int) -> np.ndarray:
+    """(n,) the one sign of D over the union of the intervals [lo, hi] of each owner, bisected; 0: not proved."""
+    low, high = np.full(n, 2, dtype=np.int64), np.full(n, -2, dtype=np.int64)
+    for round_ in range(halvings + 1):
+        sd = sign_label(denominator_enclosure(geometry, lo, hi)).astype(np.int64)
+        np.minimum.at(low, owner, np.where(sd != 0, sd, 2))
+        np.maximum.at(high, owner, np.where(sd != 0, sd, -2))
+        open_ = (sd == 0) & ~((low[owner] == -1) & (high[owner] == 1))  # an owner with both signs: refused
+        if round_ == halvings:
+            low[owner[open_]] = 0
+            break
+        owner, lo, hi = owner[open_], lo[open_], hi[open_]
+        if owner.size == 0:
+            break
+        mid = np.minimum(np.maximum(0.5 * lo + 0.5 * hi, lo), hi)
+        owner, lo, hi = np.r_[owner, owner], np.r_[lo, mid], np.r_[mid, hi]
+    return np.where((low == high) & (np.abs(low) == 1), low, 0)
+
+
+def sign_changes(pair: np.ndarray, x0: np.ndarray, x1: np.ndarray, s0: np.ndarray, s1: np.ndarray):
+    """The sign changes of f along sorted sub-pieces [x0, x1] with end signs s0, s1 (0: not proved), skipping
+    unproved signs: (pair, left, right, rising) of each, [left, right] the bracket between the two signs."""
+    seq = np.stack([s0, s1], axis=1).ravel()
+    xs = np.stack([x0, x1], axis=1).ravel()
+    grp = np.repeat(pair, 2)
+    nz = seq != 0
+    v, g, xs = seq[nz], grp[nz], xs[nz]
+    at = np.flatnonzero((v[1:] != v[:-1]) & (g[1:] == g[:-1]))
+    return g[at], xs[at], xs[at + 1], v[at + 1] > 0
+
+
+def root_d_signs(geometry: Geometry, left: np.ndarray, right: np.ndarray, halvings: int = D_HALVINGS) -> np.ndarray:
+    """(b,) the sign of D proved over each root bracket [left, right] (across phi = pi when right < left); 0: not proved."""
+    wrap = right < left
+    lo = np.r_[left, -PI_HI * np.ones(int(wrap.sum()))]
+    hi = np.r_[np.where(wrap, PI_HI, right), right[wrap]]
+    owner = np.r_[np.arange(left.size), np.flatnonzero(wrap)]
+    return _bracket_d_signs(geometry, lo, hi, owner, left.size, halvings)
