@@ -86,3 +86,15 @@ def second_aspect_topology(second_geometry):
     from intervalkin.space.aspect_topology import prove_aspects
 
     return prove_aspects(second_geometry)
+
+
+@pytest.fixture(scope="session")
+def analyze_depth4(tmp_path_factory) -> Path:
+    """``intervalkin analyze --depth 4 --out DIR --quiet`` of the paper's manipulator (about 10 s, most of it
+    the figures), written once per session for app/test_output_folder.py and checker/test_consistency.py.
+    Read it only: a test that changes files copies it first."""
+    from intervalkin.app.cli import main
+
+    out = tmp_path_factory.mktemp("analyze-depth4") / "out"
+    assert main(["analyze", "--depth", "4", "--out", str(out), "--quiet"]) == 0
+    return out
