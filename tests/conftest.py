@@ -47,8 +47,9 @@ def small_chain(geometry, workspace_depth: int, joint_depth: int, regions_depth:
 
 @pytest.fixture(scope="session")
 def regions_chain(paper_geometry):
-    """The chain shared by space/test_basic_region.py and space/test_basic_region_properties.py
-    (built once, about 8 s): workspace depth 7, joint grid 2**6, regions at depth 7."""
+    """The chain shared by space/test_basic_region.py, space/test_basic_region_properties.py and the depth-7
+    test of space/test_trajectory.py (built once, about 8 s): workspace depth 7, joint grid 2**6, regions at
+    depth 7.  Read only."""
     return small_chain(paper_geometry, 7, 6, 7, max_solves=200)
 
 
