@@ -70,6 +70,24 @@ def fold_paving(paper_geometry):
     return pave_joint_space(paper_geometry, 5, 1, fold=True, model_levels=1, windows=True)
 
 
+@pytest.fixture(scope="session")
+def joint_paving_4(paper_geometry):
+    """``pave_joint_space(paper_geometry, 4)``, the default options at depth 4: shared by
+    space/test_joint_paving.py and app/test_figures.py.  Read only."""
+    from intervalkin.space.joint_paving import pave_joint_space
+
+    return pave_joint_space(paper_geometry, 4)
+
+
+@pytest.fixture(scope="session")
+def fold_models_5(paper_geometry):
+    """The joint box paved at depth 5 with local models (one model level) and no joins: shared by
+    solve/test_fold_model.py (its fold pieces) and solve/test_local_model.py (its voided boxes).  Read only."""
+    from intervalkin.space.joint_paving import pave_joint_space
+
+    return pave_joint_space(paper_geometry, 5, join_levels=0, fold=True, model_levels=1)
+
+
 SECOND_DESIGN = Path(__file__).parents[1] / "examples" / "second_design_0246.toml"
 
 
