@@ -47,8 +47,9 @@ def small_chain(geometry, workspace_depth: int, joint_depth: int, regions_depth:
 
 @pytest.fixture(scope="session")
 def regions_chain(paper_geometry):
-    """The chain shared by space/test_basic_region.py and space/test_basic_region_properties.py
-    (built once, about 8 s): workspace depth 7, joint grid 2**6, regions at depth 7."""
+    """The chain shared by space/test_basic_region.py, space/test_basic_region_properties.py and the depth-7
+    test of space/test_trajectory.py (built once, about 8 s): workspace depth 7, joint grid 2**6, regions at
+    depth 7.  Read only."""
     return small_chain(paper_geometry, 7, 6, 7, max_solves=200)
 
 
@@ -69,6 +70,24 @@ def fold_paving(paper_geometry):
     return pave_joint_space(paper_geometry, 5, 1, fold=True, model_levels=1, windows=True)
 
 
+@pytest.fixture(scope="session")
+def joint_paving_4(paper_geometry):
+    """``pave_joint_space(paper_geometry, 4)``, the default options at depth 4: shared by
+    space/test_joint_paving.py and app/test_figures.py.  Read only."""
+    from intervalkin.space.joint_paving import pave_joint_space
+
+    return pave_joint_space(paper_geometry, 4)
+
+
+@pytest.fixture(scope="session")
+def fold_models_5(paper_geometry):
+    """The joint box paved at depth 5 with local models (one model level) and no joins: shared by
+    solve/test_fold_model.py (its fold pieces) and solve/test_local_model.py (its voided boxes).  Read only."""
+    from intervalkin.space.joint_paving import pave_joint_space
+
+    return pave_joint_space(paper_geometry, 5, join_levels=0, fold=True, model_levels=1)
+
+
 SECOND_DESIGN = Path(__file__).parents[1] / "examples" / "second_design_0246.toml"
 
 
@@ -86,3 +105,15 @@ def second_aspect_topology(second_geometry):
     from intervalkin.space.aspect_topology import prove_aspects
 
     return prove_aspects(second_geometry)
+
+
+@pytest.fixture(scope="session")
+def analyze_depth4(tmp_path_factory) -> Path:
+    """``intervalkin analyze --depth 4 --out DIR --quiet`` of the paper's manipulator (about 10 s, most of it
+    the figures), written once per session for app/test_output_folder.py and checker/test_consistency.py.
+    Read it only: a test that changes files copies it first."""
+    from intervalkin.app.cli import main
+
+    out = tmp_path_factory.mktemp("analyze-depth4") / "out"
+    assert main(["analyze", "--depth", "4", "--out", str(out), "--quiet"]) == 0
+    return out

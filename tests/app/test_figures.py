@@ -25,7 +25,6 @@ from intervalkin.app.scenes import joint_scenes, region_scenes
 from intervalkin.app.units import JOINT_AXES, WORKSPACE_AXES
 from intervalkin.core.geometry import default_geometry
 from intervalkin.paving.predicates import pave_workspace
-from intervalkin.space.joint_paving import pave_joint_space
 from intervalkin.space.joint_space import joint_paving
 from intervalkin.space.singular_surface import pave_singular_layer
 
@@ -160,12 +159,13 @@ def test_shallow_pavings_draw_empty_sets():
         pyplot().close(f)
 
 
-def test_an_adaptive_joint_paving_is_drawn_and_exported(tmp_path):
+def test_an_adaptive_joint_paving_is_drawn_and_exported(tmp_path, joint_paving_4):
     """The joint figures and joint.vtu read a direct (adaptive) joint paving as well as the voxel grid:
-    every cell with solutions is drawn, in its count's colour."""
+    every cell with solutions is drawn, in its count's colour.  (joint_paving_4, tests/conftest.py:
+    ``pave_joint_space`` of the paper's manipulator at depth 4, shared with space/test_joint_paving.py.)"""
     from intervalkin.app.vtk_export import read_vtu, write_joint_vtu
 
-    joint = pave_joint_space(default_geometry(), 4)
+    joint = joint_paving_4
     _, cells = joint_scenes(joint)
     assert {ly.key for ly in cells.layers} == {c.count for c in joint.cells if c.count > 0}
     figs = joint_figures(joint)

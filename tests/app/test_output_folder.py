@@ -1,7 +1,8 @@
 """Output folders that never lie: a manifest of what a run wrote, no stale file after a re-run,
 ``"complete": false`` until the end, nothing left by a refused run, one file mode.
 
-Runs are small (depth 3 and 4); the module makes one analysis and one workspace paving, about 7 s.
+Runs are small (depth 3 and 4); the module makes one workspace paving, and shares the session's
+``analyze --depth 4`` folder (tests/conftest.py) with checker/test_consistency.py.
 """
 
 from __future__ import annotations
@@ -31,10 +32,9 @@ def _present(folder: Path) -> set[str]:
 
 
 @pytest.fixture(scope="module")
-def run4(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("run4") / "out"
-    assert main(["analyze", "--depth", "4", "--out", str(out), "--quiet"]) == 0
-    return out
+def run4(analyze_depth4) -> Path:
+    """``analyze --depth 4`` (the session's, tests/conftest.py): read only, copied by the test that changes it."""
+    return analyze_depth4
 
 
 def test_the_manifest_lists_exactly_the_files_of_the_run(run4):

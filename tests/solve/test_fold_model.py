@@ -20,13 +20,13 @@ from intervalkin.core.interval import PI_LO
 from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.fold_model import side_of
-from intervalkin.space.joint_paving import pave_joint_space
 from tests.solve.shared import split_of
 
 
 @pytest.fixture(scope="module")
-def folds(paper_geometry):
-    jp = pave_joint_space(paper_geometry, 5, join_levels=0, fold=True, model_levels=1)
+def folds(fold_models_5):
+    """``pave_joint_space(paper_geometry, 5, join_levels=0, fold=True, model_levels=1)`` (tests/conftest.py)."""
+    jp = fold_models_5
     assert jp.pieces is not None and len(jp.pieces) >= 100, "depth 5 gives a few hundred fold boxes"
     return jp
 

@@ -24,8 +24,9 @@ from tests.solve.shared import det_zeros_along_y, split_of
 
 
 @pytest.fixture(scope="module")
-def modelled(paper_geometry):
-    jp = pave_joint_space(paper_geometry, 5, join_levels=0, fold=True, model_levels=1)
+def modelled(fold_models_5):
+    """``pave_joint_space(paper_geometry, 5, join_levels=0, fold=True, model_levels=1)`` (tests/conftest.py)."""
+    jp = fold_models_5
     assert np.count_nonzero(jp.voided) >= 200, "depth 5 proves a few hundred boxes clear by exclusion"
     return jp
 

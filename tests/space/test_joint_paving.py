@@ -26,8 +26,9 @@ from intervalkin.space.joint_paving import joint_domain, pave_joint_space
 
 
 @pytest.fixture(scope="module")
-def joint4(paper_geometry):
-    return pave_joint_space(paper_geometry, 4)
+def joint4(joint_paving_4):
+    """``pave_joint_space(paper_geometry, 4)`` (tests/conftest.py, shared with app/test_figures.py)."""
+    return joint_paving_4
 
 
 def test_counts_hold_inside_the_cells(joint4, paper_geometry):

@@ -183,8 +183,9 @@ def test_paths_pass_through_a_two_solution_cell(paths):
 
 
 @pytest.mark.slow
-def test_all_three_paths_meet_a_two_solution_cell_at_depth_7(paper_geometry):
-    jp, ra = small_chain(paper_geometry, 7, 6, 7, max_solves=200)
+def test_all_three_paths_meet_a_two_solution_cell_at_depth_7(paper_geometry, regions_chain):
+    # regions_chain (tests/conftest.py) is small_chain(paper_geometry, 7, 6, 7, max_solves=200), built once a session
+    jp, ra = regions_chain
     for pair in PAIRS:
         tr = trajectory(paper_geometry, RHO, *pair, analysis=ra, joint=jp)
         assert tr.certified and tr.through_two_solution_cell, (pair, tr.joint_cells)

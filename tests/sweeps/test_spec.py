@@ -20,16 +20,16 @@ def _doc(text: str) -> dict:
 def test_product_of_a_range_and_a_list_gives_every_combination_exactly():
     spec = parse_sweep(_doc(GRID))
     assert spec.parameters == ("platform.scale", "limits.rho_max")
-    assert [d.values for d in spec.designs[:5]] == [("0.8", "28"), ("0.8", "30"), ("0.8", "32"), ("0.8", "36"),
-                                                    ("1.0", "28")]
+    assert [d.values for d in spec.designs[:5]] == [("0.8", "34"), ("0.8", "36"), ("0.8", "38"), ("0.8", "40"),
+                                                    ("1.0", "34")]
     assert len(spec.designs) == 12 and len({d.key for d in spec.designs}) == 12
     first = tomllib.loads(spec.designs[0].geometry_toml)
-    assert first["platform"]["b1b2"] == 13.632 and first["limits"]["rho_max"] == 28  # 17.04 * 0.8, exactly
+    assert first["platform"]["b1b2"] == 13.632 and first["limits"]["rho_max"] == 34  # 17.04 * 0.8, exactly
     assert first["base"]["a2"] == [15.91, 0]  # the paper's base is untouched
 
 
 def test_the_paper_design_has_the_key_of_the_paper_geometry_whatever_its_spelling():
-    spec = parse_sweep(_doc(GRID.replace("[28, 30, 32, 36]", "[32.000]").replace('stop = 1.2', 'stop = 1.0')))
+    spec = parse_sweep(_doc(GRID.replace("[34, 36, 38, 40]", "[32.000]").replace('stop = 1.2', 'stop = 1.0')))
     paper = [d for d in spec.designs if d.values == ("1.0", "32.000")][0]
     assert paper.key == design_key(default_geometry(), Settings(4))
     assert paper.key != design_key(default_geometry(), Settings(5))
