@@ -32,7 +32,7 @@ from scipy.sparse.csgraph import connected_components
 from intervalkin.solve.fold_model import FoldModels, side_of
 from intervalkin.solve.fold_side import PAIR, pair_sides
 
-__all__ = ["FoldPieces", "fold_pieces", "fold_sides", "FACE_FRACTIONS", "PieceSignatures", "piece_signatures"]
+__all__ = ["FoldPieces", "fold_pieces", "fold_sides", "placed_edges", "FACE_FRACTIONS", "PieceSignatures", "piece_signatures"]
 
 #: Where points are placed on a shared face, as fractions of its two sides.
 FACE_FRACTIONS = ((0.5, 0.5), (0.1, 0.1), (0.1, 0.9), (0.9, 0.1), (0.9, 0.9))
@@ -92,6 +92,19 @@ def fold_sides(geometry: Geometry, models: FoldModels, box: np.ndarray, points: 
     return out
 
 
+def placed_edges(node: list[np.ndarray], placed: list[np.ndarray], q: np.ndarray, first: int,
+                 pieces: int) -> tuple[np.ndarray, np.ndarray]:
+    """(edges (2, e), witnesses (pieces, 3)) from points q placed at both ends of their contacts: node[0], node[1]
+    the piece graph nodes, placed[0], placed[1] whether each end placed it; pieces are the nodes from ``first`` on."""
+    both = placed[0] & placed[1]
+    edges = np.unique(np.sort(np.stack([node[0][both], node[1][both]]), axis=0), axis=1)
+    witness = np.full((pieces, 3), np.nan)
+    for nd, ok in zip(node, placed):
+        mine = ok & (nd >= first)
+        witness[nd[mine] - first] = q[mine]
+    return edges, witness
+
+
 def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.ndarray, face_edges: np.ndarray,
                 box: np.ndarray, models: FoldModels, workers: Workers | None = None) -> FoldPieces:
     """The piece graph edges and witnesses of fold boxes ``box`` (their ``models``) in a paving.
@@ -146,12 +159,7 @@ def fold_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.nd
             ok[is_model] = side != 0
         node.append(nd)
         placed.append(ok)
-    both = placed[0] & placed[1]
-    e = np.unique(np.sort(np.stack([node[0][both], node[1][both]]), axis=0), axis=1)
-    witness = np.full((2 * m, 3), np.nan)
-    for nd, ok in zip(node, placed):
-        piece = ok & (nd >= n)
-        witness[nd[piece] - n] = q[piece]
+    e, witness = placed_edges(node, placed, q, n, 2 * m)
     witness[2 * t_in[good] + (side_in[good] > 0)] = inner.reshape(-1, 3)[good]
     return FoldPieces(np.asarray(box, dtype=np.int64), models, e.astype(np.int64), witness)
 

@@ -31,7 +31,7 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
 from intervalkin.solve.window_fold import CLEAR, FOLD, extreme_corners, fold_piece
-from intervalkin.space.joint_pieces import FoldPieces, fold_sides
+from intervalkin.space.joint_pieces import FoldPieces, fold_sides, placed_edges
 from intervalkin.space.joint_windows import JointWindows
 
 __all__ = ["WindowPieces", "window_pieces", "window_sides"]
@@ -127,12 +127,7 @@ def window_pieces(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, clear: np.
             ok[at] = side >= 0
         node.append(nd)
         placed.append(ok)
-    both = placed[0] & placed[1]
-    edges = np.unique(np.sort(np.stack([node[0][both], node[1][both]]), axis=0), axis=1)
-    witness = np.full((2 * k, 3), np.nan)
-    for nd, ok in zip(node, placed):
-        mine = ok & (nd >= first)
-        witness[nd[mine] - first] = q[mine]
+    edges, witness = placed_edges(node, placed, q, first, 2 * k)
     # the leaf's own extreme corners: in piece 1 and piece 0 when these are not empty
     j = np.flatnonzero(pieced)
     leaf = windows.leaf[j]
