@@ -36,7 +36,7 @@ def _closed_zero_cell(fold_paving, closure) -> int:
 
 
 def _neighbours(fold_paving, cid):
-    cells, kind = jc._piece_cells(fold_paving)
+    cells, kind = jc.piece_cells(fold_paving)
     p = fold_paving.paving
     from intervalkin.paving.adjacency import shares_face
     e = shares_face(p.level, p.ijk, int(p.level.max()), periodic=(False, False, False))
@@ -98,7 +98,7 @@ def test_an_incomplete_neighbour_opens_it(fold_paving, paper_geometry, closure, 
     cid = _closed_zero_cell(fold_paving, closure)
     cells, kind, inside, outside = _neighbours(fold_paving, cid)
     victim = outside[kind[outside] == 3][0]
-    real = jc._piece_cells
+    real = jc.piece_cells
 
     def stripped(jp):
         c, k = real(jp)
@@ -106,7 +106,7 @@ def test_an_incomplete_neighbour_opens_it(fold_paving, paper_geometry, closure, 
         k[victim] = 0
         return c, k
 
-    monkeypatch.setattr(jc, "_piece_cells", stripped)
+    monkeypatch.setattr(jc, "piece_cells", stripped)
     got = closed_cells(fold_paving, paper_geometry)
     assert cid not in got.closed and "incomplete leaf" in got.open_contacts[cid]
 

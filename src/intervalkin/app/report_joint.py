@@ -62,6 +62,16 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
                    "a whole component of the joint box minus g(S): every face contact of its pieces is decided and "
                    "leads back into it (proofs/lemma-closed-cell.md), so it is separated from every other cell. "
                    "These separations are not yet in the certificates, and the lower bound above does not use them.\n")
+    sep = jc.get("separations") or {}
+    apart = [g for g in sep.get("by_signature", []) if len(g["groups"]) > 1]
+    if apart:
+        out.append("Separated cells: " + "; ".join(
+            f"{g['signature'][0]} solutions: " + " | ".join(", ".join(str(c) for c in grp) for grp in g["groups"])
+            for g in apart)
+            + f". Cells in different groups are proved to be different components (proofs/lemma-separation.md): "
+            f"at least {sep['components_at_least']} components hold a cell, and at least "
+            f"{sep['basic_regions_at_least']} basic regions lie above them. These separations are not yet in the "
+            "certificates, and the lower bound above does not use them.\n")
     frags = jc.get("fragments") or []
     if frags:
         out.append(f"{len(frags)} fragment{'' if len(frags) == 1 else 's'} (certified islands inside the undecided layer, made only by the local "

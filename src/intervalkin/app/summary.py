@@ -15,6 +15,7 @@ from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 from intervalkin.pipeline import Analysis
 from intervalkin.space.joint_closure import closed_cells
+from intervalkin.space.joint_separation import separated_cells
 from intervalkin.space.joint_space import JointPaving
 
 __all__ = ['CERTIFIED_NOTE', 'pave_summary', 'pave_table', 'joint_summary', 'joint_table', 'chain_summary', 'chain_table']
@@ -109,7 +110,8 @@ def joint_summary(jp: JointPaving) -> dict:
 
 def joint_cells_summary(jp, geometry=None) -> dict:
     """The direct joint paving: its resolution, certified share, cells (each with its certified count) and levels;
-    with ``geometry``, the cells proved closed (whole components; :mod:`intervalkin.space.joint_closure`)."""
+    with ``geometry``, the cells proved closed (whole components; :mod:`intervalkin.space.joint_closure`) and the
+    cells proved to be different components (:mod:`intervalkin.space.joint_separation`)."""
     stats = jp.paving.stats
     uniform = [st for st in stats if st["stage"] == "joint paving"]
     fs = jp.fold_stats
@@ -135,13 +137,15 @@ def joint_cells_summary(jp, geometry=None) -> dict:
         "empty_pieces": int(fs.get("empty_pieces", 0)),
         "window_models": dict(fs.get("windows", {})),
         "open_places": jp.open_places()["places"],
-        **({} if geometry is None else {"closed_cells": closed_cells(jp, geometry).to_json()}),
+        **({} if geometry is None else {"closed_cells": closed_cells(jp, geometry).to_json(),
+                                        "separations": separated_cells(jp, geometry).to_json()}),
         "certified": "every box of a cell is proved off g(S) (no singular pose has its joint vector in it: by the "
                      "torus search or by Krawczyk exclusion), or is a fold box: one sheet of g(S) crosses it as a "
                      "certified graph and each of its two pieces is joined to the cell through a point placed in "
                      "both; each cell's count and aspect split come from one complete certified solve at its "
                      "witness and hold at every point of the cell; cells are not proved to be different "
-                     "components, except the closed cells (closed_cells: each is a whole component); fragments are certified islands inside the undecided layer, made only by the "
+                     "components, except the closed cells (closed_cells: each is a whole component) and the cells in different "
+                     "groups of one signature (separations); fragments are certified islands inside the undecided layer, made only by the "
                      "local refinement and touching no face of the joint box: each lies in some component but is "
                      "not joined to one, so they are listed, not counted; fold pieces joined to no clear box are "
                      "counted under unjoined_fold_pieces and get their count from the other piece of their box "

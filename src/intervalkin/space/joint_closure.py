@@ -41,7 +41,7 @@ from intervalkin.solve.fold_side import side_of_tight
 from intervalkin.solve.window_fold import CLEAR, FOLD, extreme_corners
 from intervalkin.space.joint_window_pieces import window_sides
 
-__all__ = ["Closure", "closed_cells", "REASONS"]
+__all__ = ["Closure", "closed_cells", "REASONS", "piece_cells", "decided_traces"]
 
 _NOWRAP = (False, False, False)
 #: Why a face contact keeps a cell from being closed.
@@ -63,7 +63,7 @@ class Closure:
                              "bounds do not use it"}
 
 
-def _piece_cells(jp) -> tuple[np.ndarray, np.ndarray]:
+def piece_cells(jp) -> tuple[np.ndarray, np.ndarray]:
     """(n, 2) cell of piece s of each leaf (-2 where the leaf has no such piece), (n,) kind:
     0 incomplete, 1 one piece, 2 window fold (all axes), 3 fold box."""
     n = len(jp.cell)
@@ -95,7 +95,7 @@ def closed_cells(jp, geometry: Geometry, rounds: int = 8) -> Closure:
     every = [c.id for c in jp.cells + jp.fragments]
     if sorted(every) != list(range(len(every))):
         raise ValueError("cell ids must be 0 .. number of cells - 1")
-    cells, kind = _piece_cells(jp)
+    cells, kind = piece_cells(jp)
     edges = shares_face(p.level, p.ijk, int(p.level.max()), periodic=_NOWRAP)
     fold_dir = _fold_directions(jp, geometry)
     for _ in range(rounds):
@@ -173,6 +173,21 @@ def _check(jp, geometry: Geometry, cells: np.ndarray, kind: np.ndarray, edges: n
     blame(here[clash], "two cells meet")
     blame(there[clash], "two cells meet")
     return bad, grow
+
+
+def decided_traces(jp, geometry: Geometry, leaf: np.ndarray, flo: np.ndarray, fhi: np.ndarray) -> np.ndarray:
+    """(m, 2) int8: for each leaf and rectangle [flo, fhi] on one of its faces, whether the trace of its
+    piece 0 and piece 1 there is non-empty (1) or proved empty (0); -1 where the leaf does not decide
+    its traces on that rectangle (module docstring), or has no such piece."""
+    cells, kind = piece_cells(jp)
+    fold_dir = _fold_directions(jp, geometry)
+    out = np.full((len(leaf), 2), -1, dtype=np.int8)
+    ok = np.flatnonzero(_decides(jp, kind, leaf, flo, fhi, fold_dir))
+    if ok.size:
+        _, _, present = _trace_points(jp, geometry, kind, leaf[ok], flo[ok], fhi[ok], fold_dir)
+        out[ok] = present
+    out[cells[leaf] == -2] = -1
+    return out
 
 
 def _fold_directions(jp, geometry: Geometry) -> np.ndarray:
