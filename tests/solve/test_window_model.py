@@ -23,10 +23,12 @@ import numpy as np
 import pytest
 from flint import arb, ctx, fmpq
 
+import intervalkin.solve.window_count as wc
 import intervalkin.solve.window_model as wm
 from intervalkin.kinematics.sextic import laurent_value, reduction
 from intervalkin.solve.dkp import solve
-from intervalkin.solve.window_model import window_models, window_signature
+from intervalkin.solve.window_count import window_signature
+from intervalkin.solve.window_model import window_models
 from intervalkin.solve.window_split import root_d_signs
 from tests.solve.shared import box_across_singular_image, split_of
 
@@ -272,7 +274,7 @@ def test_a_flipped_d_sign_at_the_roots_is_caught(paper_geometry, models, monkeyp
     d_open, _ = _kinds(models)
     rows, points = _points(models, np.random.default_rng(21), 3, only=_boxes_with(models, d_open))
     good = window_signature(paper_geometry, models, rows, points)
-    monkeypatch.setattr(wm, "root_d_signs", lambda *a, **k: -root_d_signs(*a, **k))
+    monkeypatch.setattr(wc, "root_d_signs", lambda *a, **k: -root_d_signs(*a, **k))
     bad = window_signature(paper_geometry, models, rows, points)
     changed = np.flatnonzero(np.any(bad != good, axis=1))
     assert changed.size >= 20 and np.all(bad[changed, 0] == good[changed, 0])

@@ -32,7 +32,7 @@ face of R or on any axis-aligned rectangle in R (the same argument inside it).  
 piece 0 (proofs/lemma-window-fold.md).  *Two-axis* folds: when the slope is certified
 for two axes only, it is checked along the third on two edges of R, and the pieces retract to
 those edges (statement 4' of the lemma).  A point is placed in a piece by its window count,
-certified at the point (:func:`intervalkin.solve.window_model.window_signature`).
+certified at the point (:func:`intervalkin.solve.window_count.window_signature`).
 """
 
 from __future__ import annotations
@@ -45,7 +45,8 @@ from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import sign_label
 from intervalkin.solve.simple_roots import ReducedBoxes
-from intervalkin.solve.window_model import DET_SIGN, WindowModels, window_signature
+from intervalkin.solve.window_count import window_signature
+from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "WindowFolds", "window_folds", "fold_piece", "extreme_corners"]
 

@@ -25,7 +25,7 @@ certified for all r in R^2 split the circle into *arcs*:
 A box is modelled (``ok``) when every window is modelled so.  Then the
 roots off the windows, their number and their det A signs, are the same for every r in
 R (:attr:`WindowModels.off`), and the signature at a point q of R is that plus the roots
-in each window at q, counted by :func:`window_signature` from certified signs of f(.; q).
+in each window at q, counted by :func:`intervalkin.solve.window_count.window_signature` from certified signs of f(.; q).
 
 What is certified: every sign used is proved with ball arithmetic over (R^2, piece)
 (:class:`intervalkin.solve.simple_roots.ReducedBoxes`, outward by construction, cos and
@@ -43,10 +43,10 @@ from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, PI_LO, sign_label
 from intervalkin.solve.simple_roots import PIECES, ReducedBoxes, initial_pieces
-from intervalkin.solve.window_split import cut_at_d_zeros, denominator_enclosure, root_d_signs, sign_changes, sub_windows
+from intervalkin.solve.window_split import cut_at_d_zeros, denominator_enclosure, sub_windows
 
-__all__ = ["WindowModels", "window_models", "window_signature", "denominator_enclosure", "DET_SIGN",
-           "WINDOW_HALVINGS", "DEGREE_HALVINGS", "POINT_HALVINGS"]
+__all__ = ["WindowModels", "window_models", "cut_interval", "denominator_enclosure", "DET_SIGN",
+           "WINDOW_HALVINGS", "DEGREE_HALVINGS", "POINT_HALVINGS", "POINT_CROWD"]
 
 #: At a simple root phi* of f with D(phi*) != 0: sign det A = DET_SIGN * sign D(phi*) * sign f'(phi*).
 #: det A = D g' exactly at a solution, with f = D^2 g (proofs/lemma-window-model.md, step 2).
@@ -63,7 +63,7 @@ _CHUNK = 4096
 #: Pieces narrower than this are not bisected further.
 _MIN_WIDTH = 2.0**-30
 #: A (point, window) pair with more open sub-pieces than this is left undecided.
-_CROWD = 64
+POINT_CROWD = 64
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,7 +119,7 @@ class WindowModels:
         return start, np.searchsorted(self.window_box, box, side="right") - start
 
 
-def _node(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def cut_interval(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The interval of a cut point: [x, x], or around phi = pi for the seam cut (+-PI_HI)."""
     seam = np.abs(x) == PI_HI
     return np.where(seam, -PI_HI * (x < 0) + PI_LO * (x > 0), x), np.where(seam, -PI_LO * (x < 0) + PI_HI * (x > 0), x)
@@ -215,7 +215,7 @@ def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, de
     pos = np.arange(m) - first[owner]
     prev = np.where(pos == 0, first[owner] + count[owner] - 1, np.arange(m) - 1)  # cyclic, across phi = pi
     # the sign of f at the start cut of each piece: a point enclosure, or the sign of a neighbour with f != 0
-    cut = sign_label(data.enclosure(owner, *_node(lo), 0)).astype(np.int64)
+    cut = sign_label(data.enclosure(owner, *cut_interval(lo), 0)).astype(np.int64)
     for j in (np.arange(m), prev):
         known = kind[j] == 0
         assert not np.any(cut[known] * sign[j][known] < 0), "two enclosures of f disagree: unsound evaluation"
@@ -248,7 +248,7 @@ def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, de
     # root lies before the first zero (f' > 0) or after the last one (f' < 0): D there has the sign of D
     # at the piece's start or end
     end = np.where(sign[mono] > 0, lo[mono], hi[mono])
-    d_end = sign_label(denominator_enclosure(geometry, *_node(end))).astype(np.int64)
+    d_end = sign_label(denominator_enclosure(geometry, *cut_interval(end))).astype(np.int64)
     d_arc = _uniform(np.where(d_piece != 0, d_piece, d_end), arc[mono], n_arcs)
     root = mono_arc & (s_start != s_end)
     bad_arc = (mono_arc & (sigma == 0)) | (root & (d_arc == 0))
@@ -295,103 +295,3 @@ def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, de
     piece_window, piece_lo, piece_hi = cut_at_d_zeros(geometry, renumber[run[pk]], plo[pk], phi[pk], run_d[rk] == 0)
     return WindowModels(boxes, ok, off, wbox[rw[rk]], p_degree[first[rk]].astype(np.int8), ends[rk].astype(np.int8),
                         run_d[rk].astype(np.int8), piece_window, piece_lo, piece_hi)
-
-
-def window_signature(geometry: Geometry, models: WindowModels, rows: np.ndarray, points: np.ndarray,
-                     halvings: int = POINT_HALVINGS) -> np.ndarray:
-    """(m, 3) int64: the certified (count, n_wa1, n_wa2) at joint vectors ``points`` (m, 3), -1 where undecided.
-
-    ``rows`` (m,) names the box of ``models`` that holds each point.  In each window the signs of
-    f(.; q) (r = q^2 an interval) are proved at cut points, bisected where needed: k sign changes
-    prove at least k roots; with k = degree, or k = degree - 1 and both end signs proved (at q
-    for an end sign 0), the degree and the parity prove exactly k, all simple; otherwise every
-    sub-piece must show f != 0, or df/dphi != 0 with certified end signs.  A root where f rises
-    has det A of sign DET_SIGN * sign(D); where it falls, the other sign (d_sign 0: sign(D) proved
-    on the root's bracket).  Undecided: boxes not modelled, points on or very near g(S) (a
-    multiple root), a root's bracket where D's sign is not proved, and (never when the model is
-    sound) more sign changes than the degree or a sign at q against the model's.
-    """
-    rows = np.asarray(rows, dtype=np.int64)
-    q = np.asarray(points, dtype=np.float64)
-    if q.ndim != 2 or q.shape[1] != 3 or rows.shape != (len(q),):
-        raise InputError(f"points: expected shape (m, 3) and rows (m,), got {q.shape} and {rows.shape}")
-    box = models.boxes[rows]
-    if np.any(~((box[:, :, 0] <= q) & (q <= box[:, :, 1]))):
-        raise InputError("points: every point must lie in its box models.boxes[rows]")
-    out = np.full((len(q), 3), -1, dtype=np.int64)
-    live = np.flatnonzero(models.ok[rows])
-    wstart, wcount = models.windows_of(rows[live])
-    pt = np.repeat(np.arange(live.size), wcount)  # pairs (point, window)
-    win = np.repeat(wstart - (np.cumsum(wcount) - wcount), wcount) + np.arange(pt.size)
-    pstart = np.searchsorted(models.piece_window, win, side="left")
-    pcount = np.searchsorted(models.piece_window, win, side="right") - pstart
-    pair = np.repeat(np.arange(pt.size), pcount)  # sub-pieces, first the window's pieces
-    piece = np.repeat(pstart - (np.cumsum(pcount) - pcount), pcount) + np.arange(pair.size)
-    lo, hi = models.piece_lo[piece], models.piece_hi[piece]
-    data = ReducedBoxes(geometry, np.stack([q[live], q[live]], axis=-1))
-
-    def node_sign(at: np.ndarray, x: np.ndarray) -> np.ndarray:
-        return sign_label(data.enclosure(pt[at], *_node(x), 0)).astype(np.int64)
-
-    # the window's ends carry their certified signs over all of R^2; the other cuts are proved at q
-    s0, s1 = node_sign(pair, lo), node_sign(pair, hi)
-    head = np.r_[True, pair[1:] != pair[:-1]]
-    tail = np.r_[pair[1:] != pair[:-1], True]
-    e0, e1 = models.end_signs[win[pair[head]], 0], models.end_signs[win[pair[tail]], 1]
-    s0[head], s1[tail] = np.where(e0 != 0, e0, s0[head]), np.where(e1 != 0, e1, s1[tail])  # 0: proved at q
-    done = np.zeros(pt.size, dtype=bool)
-    result = np.full((pt.size, 2), -1, dtype=np.int64)  # (roots, roots with det A > 0)
-    fixed = np.zeros(pair.size, dtype=bool)  # sub-piece proved: f != 0, or monotone with certified end signs
-    degree = models.degree[win].astype(np.int64)
-    rising = DET_SIGN * models.d_sign[win] > 0
-    d_open = models.d_sign[win] == 0
-    for round_ in range(halvings + 1):
-        order = np.lexsort((lo, piece, pair))
-        pair, piece, lo, hi, s0, s1, fixed = (a[order] for a in (pair, piece, lo, hi, s0, s1, fixed))
-        open_ = np.flatnonzero(~fixed)
-        sf = sign_label(data.enclosure(pt[pair[open_]], lo[open_], hi[open_], 0)).astype(np.int64)
-        # f's sign on a sub-piece against a sign at its end (the model's, at a window end): refuse the pair
-        clash = np.bincount(pair[open_], weights=(sf * s0[open_] < 0) | (sf * s1[open_] < 0), minlength=pt.size) > 0
-        s0[open_] = np.where(sf != 0, sf, s0[open_])
-        s1[open_] = np.where(sf != 0, sf, s1[open_])
-        mono = np.flatnonzero(sf == 0)
-        sd = sign_label(data.enclosure(pt[pair[open_[mono]]], lo[open_[mono]], hi[open_[mono]], 1))
-        fixed[open_] = sf != 0
-        fixed[open_[mono]] = (sd != 0) & (s0[open_[mono]] != 0) & (s1[open_[mono]] != 0)
-        at, left, right, up_ = sign_changes(pair, lo, hi, s0, s1)
-        k, up = np.bincount(at, minlength=pt.size), np.bincount(at, weights=up_, minlength=pt.size).astype(np.int64)
-        unfixed = np.bincount(pair, weights=~fixed, minlength=pt.size)
-        whole = unfixed == 0
-        first, last = np.r_[True, pair[1:] != pair[:-1]], np.r_[pair[1:] != pair[:-1], True]
-        known = np.zeros(pt.size, dtype=bool)  # both end signs of the window proved (at q, for an end sign 0)
-        known[pair[first]] = (s0[first] != 0) & (s1[last] != 0)
-        # at most `degree` roots with multiplicity, of the parity of the end signs: k = degree - 1 leaves only k
-        now = ~done & ~clash & (k <= degree) & ((k == degree) | ((k == degree - 1) & known) | whole)
-        # where D may vanish on the window: the sign of D proved on the bracket of each (simple) root
-        roots = np.flatnonzero((now & d_open)[at])
-        d_root = root_d_signs(geometry, left[roots], right[roots])
-        now &= np.bincount(at[roots], weights=d_root == 0, minlength=pt.size) == 0
-        pos = np.bincount(at[roots], weights=DET_SIGN * d_root * np.where(up_[roots], 1, -1) > 0, minlength=pt.size)
-        result[now] = np.stack([k, np.where(d_open, pos, np.where(rising, up, k - up))], axis=1)[now]
-        refuse = ~done & ((k > degree) | clash)  # more changes than the degree allows, or a clash: never if sound
-        result[refuse] = -1
-        crowd = ~done & ~now & (unfixed > _CROWD)  # on a multiple root, where the open sub-pieces double each round
-        done |= now | refuse | crowd
-        drop = done[pair]
-        pair, piece, lo, hi, s0, s1, fixed = (a[~drop] for a in (pair, piece, lo, hi, s0, s1, fixed))
-        if pair.size == 0 or round_ == halvings:
-            break
-        cut = np.flatnonzero(~fixed)
-        mid = np.minimum(np.maximum(0.5 * lo[cut] + 0.5 * hi[cut], lo[cut]), hi[cut])
-        sm = node_sign(pair[cut], mid)
-        pair, piece = np.r_[pair, pair[cut]], np.r_[piece, piece[cut]]
-        lo, hi = np.r_[lo, mid], np.r_[hi, hi[cut]]
-        hi[cut] = mid
-        s0, s1 = np.r_[s0, sm], np.r_[s1, s1[cut]]
-        s1[cut] = sm
-        fixed = np.r_[fixed, np.zeros(cut.size, dtype=bool)]
-    good = np.bincount(pt, weights=result[:, 0] < 0, minlength=live.size) == 0
-    total = np.stack([np.bincount(pt, weights=result[:, i], minlength=live.size) for i in (0, 1)], axis=1)
-    sig = models.off[rows[live]] + np.stack([total[:, 0], total[:, 1], total[:, 0] - total[:, 1]], axis=1).astype(np.int64)
-    out[live[good]] = sig[good]
-    return out

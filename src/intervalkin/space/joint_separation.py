@@ -171,6 +171,11 @@ def _worth_deciding(sig: np.ndarray, cells: np.ndarray, a: np.ndarray, b: np.nda
     return look & ~same
 
 
+def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    graph = coo_matrix((np.ones(a.size, dtype=np.int8), (a, b)), shape=(n, n))
+    return connected_components(graph, directed=False)[1]
+
+
 def separated_cells(jp, geometry: Geometry) -> Separation:
     """The cells of a joint paving grouped, signature by signature, by the components of G_sigma (module docstring)."""
     p = jp.paving
@@ -183,27 +188,32 @@ def separated_cells(jp, geometry: Geometry) -> Separation:
     edges = shares_face(p.level, p.ijk, int(p.level.max()), periodic=_NOWRAP)
     a, b = edges
     look = _worth_deciding(sig, cells, a, b)
-    flo = np.maximum(p.lo[a[look]], p.lo[b[look]])
-    fhi = np.minimum(p.hi[a[look]], p.hi[b[look]])
     trace = np.full((edges.shape[1], 2, 2), -1, dtype=np.int8)  # (contact, end a/b, piece) 1 / 0 empty / -1
-    for end, leaf in enumerate((a[look], b[look])):
-        trace[look, end] = decided_traces(jp, geometry, leaf, flo, fhi)
+    done = np.zeros(edges.shape[1], dtype=bool)
     groups: dict[tuple[int, int, int], tuple[tuple[int, ...], ...]] = {}
     for s in sorted({c.signature for c in every}):
+        mine = [c for c in every if c.signature == s]
         target = np.array(s, dtype=np.int64)
         may = (sig == target).all(axis=2) | (sig[:, :, 0] == UNKNOWN)  # (n, 2) pieces that may carry s
         admit = np.where(has_model, may.any(axis=1), (counts == ANY) | ((counts >> s[0]) & 1 == 1))
-        # a contact is cut when an end decides its traces and each of its pieces that may carry s is empty there
-        cut = np.zeros(edges.shape[1], dtype=bool)
-        for end, leaf in enumerate((a, b)):
-            m = may[leaf]
-            empty = (trace[:, end] == 0) | ~m
-            cut |= has_model[leaf] & m.any(axis=1) & empty.all(axis=1)
-        keep = admit[a] & admit[b] & ~cut
-        graph = coo_matrix((np.ones(int(keep.sum()), dtype=np.int8), (a[keep], b[keep])), shape=(n, n))
-        _, comp = connected_components(graph, directed=False)
+        keep = admit[a] & admit[b]
+        comp = _components(n, a[keep], b[keep])
+        seed = np.array([comp[np.flatnonzero((cells == c.id).any(axis=1))[0]] for c in mine])
+        shared = np.unique(seed)[np.bincount(np.unique(seed, return_inverse=True)[1]) > 1]
+        if shared.size:  # traces only split groups: decided (side tests) only inside a group holding two cells
+            new = np.flatnonzero(keep & look & ~done & np.isin(comp[a], shared))
+            flo, fhi = np.maximum(p.lo[a[new]], p.lo[b[new]]), np.minimum(p.hi[a[new]], p.hi[b[new]])
+            for end, leaf in enumerate((a[new], b[new])):
+                trace[new, end] = decided_traces(jp, geometry, leaf, flo, fhi)
+            done[new] = True
+            # a contact is cut when an end decides its traces and each of its pieces that may carry s is empty there
+            for end, leaf in enumerate((a, b)):
+                m = may[leaf]
+                empty = (trace[:, end] == 0) | ~m
+                keep &= ~(has_model[leaf] & m.any(axis=1) & empty.all(axis=1))
+            comp = _components(n, a[keep], b[keep])
         by_comp: dict[int, list[int]] = {}
-        for c in (c for c in every if c.signature == s):
+        for c in mine:
             leaves = np.flatnonzero((cells == c.id).any(axis=1))
             if not admit[leaves].all() or np.unique(comp[leaves]).size != 1:
                 raise AssertionError(f"soundness bug: cell {c.id} is not inside one component of G_sigma "

@@ -23,7 +23,8 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
 from intervalkin.solve.window_fold import CLEAR, FOLD, WindowFolds, window_folds
-from intervalkin.solve.window_model import WindowModels, window_models, window_signature
+from intervalkin.solve.window_count import window_signature
+from intervalkin.solve.window_model import WindowModels, window_models
 
 __all__ = ["JointWindows", "joint_windows"]
 
