@@ -69,7 +69,7 @@ def test_a_cut_contact_carries_no_point_of_the_piece(fold_paving, paper_geometry
     pick = np.flatnonzero(two[a])[:40000]
     leaf, other = a[pick], b[pick]
     flo, fhi = np.maximum(p.lo[leaf], p.lo[other]), np.minimum(p.hi[leaf], p.hi[other])
-    trace = decided_traces(fold_paving, paper_geometry, leaf, flo, fhi)
+    trace, points = decided_traces(fold_paving, paper_geometry, leaf, flo, fhi)
     empty = np.argwhere(trace == 0)
     assert len(empty) > 100
     rng = np.random.default_rng(12)

@@ -86,6 +86,10 @@ class WindowModels:
         a sub-window: the sign of D is proved at each root, at the point).
     piece_window, piece_lo, piece_hi : (p,) the pieces of each window in circle order (a window
         may run across phi = pi: its pieces then end at PI_HI and restart at -PI_HI).
+    root_box, root_lo, root_hi : (a,) the arcs off the windows that hold a root (exactly one, for
+        every point of the box), sorted by box: the arc runs from root_lo to root_hi in circle
+        order (across phi = pi when root_hi <= root_lo).  ``off[:, 0]`` of a modelled box is its
+        number of such arcs; the rest of the circle off the windows holds no root.
     """
 
     boxes: np.ndarray
@@ -98,6 +102,9 @@ class WindowModels:
     piece_window: np.ndarray
     piece_lo: np.ndarray
     piece_hi: np.ndarray
+    root_box: np.ndarray
+    root_lo: np.ndarray
+    root_hi: np.ndarray
 
     def concat(self, other: "WindowModels") -> "WindowModels":
         """The models of these boxes followed by those of ``other`` (window and piece indices shifted)."""
@@ -107,7 +114,8 @@ class WindowModels:
             (self.window_box, other.window_box + n), (self.degree, other.degree),
             (self.end_signs, other.end_signs), (self.d_sign, other.d_sign),
             (self.piece_window, other.piece_window + w), (self.piece_lo, other.piece_lo),
-            (self.piece_hi, other.piece_hi))))
+            (self.piece_hi, other.piece_hi), (self.root_box, other.root_box + n), (self.root_lo, other.root_lo),
+            (self.root_hi, other.root_hi))))
 
     def box_wide(self) -> np.ndarray:
         """(w,) bool: windows whose end signs and sign of D hold over the whole box (non-zero)."""
@@ -193,7 +201,8 @@ def window_models(geometry: Geometry, boxes: np.ndarray, pieces: int = PIECES, h
     if len(boxes) == 0:
         z = np.zeros(0, dtype=np.int64)
         return WindowModels(boxes, z.astype(bool), np.zeros((0, 3), np.int64), z, z.astype(np.int8),
-                            np.zeros((0, 2), np.int8), z.astype(np.int8), z, z.astype(float), z.astype(float))
+                            np.zeros((0, 2), np.int8), z.astype(np.int8), z, z.astype(float), z.astype(float),
+                            z, z.astype(float), z.astype(float))
     parts = [_chunk(geometry, boxes[k:k + _CHUNK], pieces, halvings, degree_halvings)
              for k in range(0, len(boxes), _CHUNK)]
     base_box = np.cumsum([0] + [len(p.ok) for p in parts])
@@ -203,7 +212,9 @@ def window_models(geometry: Geometry, boxes: np.ndarray, pieces: int = PIECES, h
                         cat([p.window_box + b for p, b in zip(parts, base_box)]), cat([p.degree for p in parts]),
                         cat([p.end_signs for p in parts]), cat([p.d_sign for p in parts]),
                         cat([p.piece_window + b for p, b in zip(parts, base_win)]),
-                        cat([p.piece_lo for p in parts]), cat([p.piece_hi for p in parts]))
+                        cat([p.piece_lo for p in parts]), cat([p.piece_hi for p in parts]),
+                        cat([p.root_box + b for p, b in zip(parts, base_box)]), cat([p.root_lo for p in parts]),
+                        cat([p.root_hi for p in parts]))
 
 
 def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, degree_halvings: int) -> WindowModels:
@@ -293,5 +304,9 @@ def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, de
     renumber = np.cumsum(rk) - 1
     pk = rk[run]
     piece_window, piece_lo, piece_hi = cut_at_d_zeros(geometry, renumber[run[pk]], plo[pk], phi[pk], run_d[rk] == 0)
+    # the arcs holding one fixed root, from their first cut to the end of their last piece
+    arc_last = np.r_[arc_first[1:], owner.size] - 1
+    held = np.flatnonzero(root & ok[arc_box])
     return WindowModels(boxes, ok, off, wbox[rw[rk]], p_degree[first[rk]].astype(np.int8), ends[rk].astype(np.int8),
-                        run_d[rk].astype(np.int8), piece_window, piece_lo, piece_hi)
+                        run_d[rk].astype(np.int8), piece_window, piece_lo, piece_hi,
+                        arc_box[held], lo[arc_first[held]], hi[arc_last[held]])

@@ -175,19 +175,22 @@ def _check(jp, geometry: Geometry, cells: np.ndarray, kind: np.ndarray, edges: n
     return bad, grow
 
 
-def decided_traces(jp, geometry: Geometry, leaf: np.ndarray, flo: np.ndarray, fhi: np.ndarray) -> np.ndarray:
-    """(m, 2) int8: for each leaf and rectangle [flo, fhi] on one of its faces, whether the trace of its
-    piece 0 and piece 1 there is non-empty (1) or proved empty (0); -1 where the leaf does not decide
-    its traces on that rectangle (module docstring), or has no such piece."""
+def decided_traces(jp, geometry: Geometry, leaf: np.ndarray, flo: np.ndarray,
+                   fhi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each leaf and rectangle [flo, fhi] on one of its faces: (m, 2) int8, whether the trace of its
+    piece 0 and piece 1 there is non-empty (1) or proved empty (0), -1 where the leaf does not decide its
+    traces on that rectangle (module docstring) or has no such piece; and (m, 2, 3) a point of each
+    non-empty trace (a point of the rectangle proved to lie in that piece)."""
     cells, kind = piece_cells(jp)
     fold_dir = _fold_directions(jp, geometry)
     out = np.full((len(leaf), 2), -1, dtype=np.int8)
+    pts = np.full((len(leaf), 2, 3), np.nan)
     ok = np.flatnonzero(_decides(jp, kind, leaf, flo, fhi, fold_dir))
     if ok.size:
-        _, _, present = _trace_points(jp, geometry, kind, leaf[ok], flo[ok], fhi[ok], fold_dir)
-        out[ok] = present
+        pts[ok], _, out[ok] = _trace_points(jp, geometry, kind, leaf[ok], flo[ok], fhi[ok], fold_dir)
     out[cells[leaf] == -2] = -1
-    return out
+    pts[out != 1] = np.nan
+    return out, pts
 
 
 def _fold_directions(jp, geometry: Geometry) -> np.ndarray:

@@ -44,6 +44,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.paving.adjacency import shares_face
 from intervalkin.solve.window_fold import CLEAR, FOLD
 from intervalkin.space.joint_closure import decided_traces, piece_cells
+from intervalkin.space.joint_patterns import compatible, pattern_at, unit_overlaps, window_patterns
 
 __all__ = ["Separation", "separated_cells", "leaf_signatures", "possible_counts"]
 
@@ -176,6 +177,18 @@ def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return connected_components(graph, directed=False)[1]
 
 
+def _runs(keys: np.ndarray, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(start, length) of the run of each ``wanted`` value in the sorted array ``keys``."""
+    lo = np.searchsorted(keys, wanted, side="left")
+    return lo, np.searchsorted(keys, wanted, side="right") - lo
+
+
+def _expand(src: np.ndarray, start: np.ndarray, length: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs (src[i], start[i] + j) for j < length[i]."""
+    rep = np.repeat(np.arange(src.size), length)
+    return src[rep], start[rep] + np.arange(rep.size) - np.repeat(np.cumsum(length) - length, length)
+
+
 def separated_cells(jp, geometry: Geometry) -> Separation:
     """The cells of a joint paving grouped, signature by signature, by the components of G_sigma (module docstring)."""
     p = jp.paving
@@ -185,33 +198,77 @@ def separated_cells(jp, geometry: Geometry) -> Separation:
     counts = possible_counts(jp)
     has_model = (sig[:, :, 0] != NO_PIECE).any(axis=1)
     cells, _ = piece_cells(jp)
-    edges = shares_face(p.level, p.ijk, int(p.level.max()), periodic=_NOWRAP)
-    a, b = edges
-    look = _worth_deciding(sig, cells, a, b)
-    trace = np.full((edges.shape[1], 2, 2), -1, dtype=np.int8)  # (contact, end a/b, piece) 1 / 0 empty / -1
-    done = np.zeros(edges.shape[1], dtype=bool)
+    a, b = shares_face(p.level, p.ijk, int(p.level.max()), periodic=_NOWRAP)
+    pat = _Patterns(jp, has_model, counts)
+    is_p = pat.is_p
+    # the traces of the ends that may decide them, once for every signature
+    look = (_worth_deciding(sig, cells, a, b) & ~is_p[a] & ~is_p[b]) | (is_p[a] ^ is_p[b])
+    c = np.flatnonzero(look)
+    flo, fhi = np.maximum(p.lo[a[c]], p.lo[b[c]]), np.minimum(p.hi[a[c]], p.hi[b[c]])
+    trace = np.full((a.size, 2, 2), -1, dtype=np.int8)  # (contact, end a/b, piece): 1, 0 empty, -1 not decided
+    where = np.full((a.size, 2, 2, 3), np.nan)
+    for end, leaf in enumerate((a[c], b[c])):
+        solid = ~is_p[leaf]
+        trace[c[solid], end], where[c[solid], end] = decided_traces(jp, geometry, leaf[solid], flo[solid], fhi[solid])
+    # contacts of a pattern leaf L with a solid end E: the pattern of L at E's trace points
+    mixed = np.flatnonzero(is_p[a] ^ is_p[b])
+    e_end = np.where(is_p[a[mixed]], 1, 0)
+    e_leaf, l_leaf = np.where(e_end == 1, b[mixed], a[mixed]), np.where(e_end == 1, a[mixed], b[mixed])
+    e_trace, e_where = trace[mixed, e_end], where[mixed, e_end]
+    code_at = np.full((mixed.size, 2), -1, dtype=np.int64)
+    for slot in (0, 1):
+        at = np.flatnonzero(e_trace[:, slot] == 1)
+        code_at[at, slot] = pat.at(geometry, l_leaf[at], e_where[at, slot])
+    both = np.flatnonzero(is_p[a] & is_p[b])
+    overlap = pat.overlaps(a[both], b[both])
     groups: dict[tuple[int, int, int], tuple[tuple[int, ...], ...]] = {}
     for s in sorted({c.signature for c in every}):
         mine = [c for c in every if c.signature == s]
         target = np.array(s, dtype=np.int64)
         may = (sig == target).all(axis=2) | (sig[:, :, 0] == UNKNOWN)  # (n, 2) pieces that may carry s
-        admit = np.where(has_model, may.any(axis=1), (counts == ANY) | ((counts >> s[0]) & 1 == 1))
+        admit = ~is_p & np.where(has_model, may.any(axis=1), (counts == ANY) | ((counts >> s[0]) & 1 == 1))
+        # solid-solid contacts: cut when an end decides its traces and each of its pieces that may carry s is empty
         keep = admit[a] & admit[b]
-        comp = _components(n, a[keep], b[keep])
-        seed = np.array([comp[np.flatnonzero((cells == c.id).any(axis=1))[0]] for c in mine])
-        shared = np.unique(seed)[np.bincount(np.unique(seed, return_inverse=True)[1]) > 1]
-        if shared.size:  # traces only split groups: decided (side tests) only inside a group holding two cells
-            new = np.flatnonzero(keep & look & ~done & np.isin(comp[a], shared))
-            flo, fhi = np.maximum(p.lo[a[new]], p.lo[b[new]]), np.minimum(p.hi[a[new]], p.hi[b[new]])
-            for end, leaf in enumerate((a[new], b[new])):
-                trace[new, end] = decided_traces(jp, geometry, leaf, flo, fhi)
-            done[new] = True
-            # a contact is cut when an end decides its traces and each of its pieces that may carry s is empty there
-            for end, leaf in enumerate((a, b)):
-                m = may[leaf]
-                empty = (trace[:, end] == 0) | ~m
-                keep &= ~(has_model[leaf] & m.any(axis=1) & empty.all(axis=1))
-            comp = _components(n, a[keep], b[keep])
+        for end, leaf in enumerate((a, b)):
+            m = may[leaf]
+            empty = (trace[:, end] == 0) | ~m
+            keep &= ~(has_model[leaf] & m.any(axis=1) & empty.all(axis=1))
+        src, dst = [a[keep]], [b[keep]]
+        start, length, sel = pat.rows(s[0])
+        # solid-pattern contacts: the pattern found at a trace point, or every pattern with the count
+        m = may[e_leaf] & has_model[e_leaf, None]
+        deciding = has_model[e_leaf] & np.all((e_trace != -1) | ~m, axis=1)
+        for slot in (0, 1):
+            hit = np.flatnonzero(admit[e_leaf] & deciding & m[:, slot] & (e_trace[:, slot] == 1))
+            row = pat.row_of(l_leaf[hit], code_at[hit, slot])
+            known = row >= 0
+            other = known & (pat.count[np.maximum(row, 0)] != s[0])
+            if np.any(other & (sig[e_leaf[hit], slot, 0] == s[0])):
+                bad = hit[other & (sig[e_leaf[hit], slot, 0] == s[0])][:3]
+                raise AssertionError("soundness bug: a trace point of one signature has a pattern of another count "
+                                     f"(contacts {e_leaf[bad].tolist()} / {l_leaf[bad].tolist()})")
+            known &= ~other  # a trace of unknown signature whose point has another count carries no s
+            hit = hit[known | (row < 0)]
+            row = row[known | (row < 0)]
+            known = row >= 0
+            src.append(e_leaf[hit[known]])
+            dst.append(n + row[known])
+            blind = hit[~known]
+            x, y = _expand(e_leaf[blind], start[l_leaf[blind]], length[l_leaf[blind]])
+            src.append(x)
+            dst.append(n + sel[y])
+        blind = np.flatnonzero(admit[e_leaf] & ~deciding)
+        x, y = _expand(e_leaf[blind], start[l_leaf[blind]], length[l_leaf[blind]])
+        src.append(x)
+        dst.append(n + sel[y])
+        # pattern-pattern contacts: the pairs of patterns with the count that may meet on the face
+        i, ra = _expand(np.arange(both.size), start[a[both]], length[a[both]])
+        j, rb = _expand(np.arange(i.size), start[b[both[i]]], length[b[both[i]]])
+        ga, gb = sel[ra[j]], sel[rb]
+        meet = pat.compatible(ga, gb, overlap[i[j]])
+        src.append(n + ga[meet])
+        dst.append(n + gb[meet])
+        comp = _components(n + len(pat.count), np.concatenate(src), np.concatenate(dst))
         by_comp: dict[int, list[int]] = {}
         for c in mine:
             leaves = np.flatnonzero((cells == c.id).any(axis=1))
@@ -221,3 +278,72 @@ def separated_cells(jp, geometry: Geometry) -> Separation:
             by_comp.setdefault(int(comp[leaves[0]]), []).append(c.id)
         groups[s] = tuple(tuple(sorted(g)) for g in sorted(by_comp.values()))
     return Separation(groups)
+
+
+class _Patterns:
+    """The pattern nodes of a paving: leaves with a window model and no complete model (module docstring of
+    :mod:`intervalkin.space.joint_patterns`), one node per pattern the leaf may hold."""
+
+    def __init__(self, jp, has_model: np.ndarray, counts: np.ndarray):
+        n = len(jp.cell)
+        self.is_p = np.zeros(n, dtype=bool)
+        self.count = np.zeros(0, dtype=np.int64)
+        self._leaf = np.zeros(0, dtype=np.int64)
+        self._code = np.zeros(0, dtype=np.int64)
+        self._row = np.zeros(0, dtype=np.int64)
+        w = jp.windows
+        if w is None:
+            return
+        self._w = w
+        self._wp = window_patterns(w.models)
+        leaf = w.leaf[self._wp.box]
+        # a leaf said to hold anything (counts ANY) stays one node, whatever its model
+        keep = ~has_model[leaf] & (counts[leaf] != ANY)
+        self._row = np.flatnonzero(keep)
+        self._leaf, self._code, self.count = leaf[keep], self._wp.code[keep], self._wp.count[keep]
+        self.is_p[self._leaf] = True
+
+    def overlaps(self, leaf_a: np.ndarray, leaf_b: np.ndarray) -> np.ndarray:
+        """(c, U, U) unit overlaps of pattern leaves sharing a face (see :func:`unit_overlaps`)."""
+        if self._leaf.size == 0:
+            return np.zeros((leaf_a.size, 1, 1), dtype=bool)
+        box_a, box_b = (np.searchsorted(self._w.leaf, x) for x in (leaf_a, leaf_b))
+        return unit_overlaps(self._w.models, self._wp, box_a, box_b)
+
+    def compatible(self, node_a: np.ndarray, node_b: np.ndarray, overlap: np.ndarray) -> np.ndarray:
+        """Whether pattern nodes node_a[i] and node_b[i] of two leaves sharing a face may meet on it."""
+        return compatible(self._w.models, self._wp, self._row[node_a], self._row[node_b], overlap)
+
+    def rows(self, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The rows with ``count``, compacted: (n,) start and length of each leaf's run among them, and the
+        global row of each compacted one."""
+        n = len(self.is_p)
+        sel = self.count == count
+        start = np.zeros(n, dtype=np.int64)
+        length = np.zeros(n, dtype=np.int64)
+        if self._leaf.size:
+            leaves = np.flatnonzero(self.is_p)
+            first, size = _runs(self._leaf, leaves)
+            before = np.r_[0, np.cumsum(sel)]
+            # rows with the count are not contiguous inside a leaf's run: index them through a compacted view
+            start[leaves] = before[first]
+            length[leaves] = before[first + size] - before[first]
+        return start, length, np.flatnonzero(sel)
+
+    def row_of(self, leaf: np.ndarray, code: np.ndarray) -> np.ndarray:
+        """Row of (leaf, code), -1 where code is -1 or not a row."""
+        out = np.full(leaf.size, -1, dtype=np.int64)
+        if self._leaf.size == 0 or leaf.size == 0:
+            return out
+        first, size = _runs(self._leaf, leaf)
+        for k in range(int(size.max()) if size.size else 0):  # a leaf has a few patterns: scan them
+            hit = (k < size) & (out < 0) & (code >= 0)
+            idx = np.where(hit, first + k, 0)
+            ok = hit & (self._code[idx] == code)
+            out[ok] = idx[ok]
+        return out
+
+    def at(self, geometry: Geometry, leaf: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """The certified pattern code of ``leaf`` at ``points`` (-1 where undecided)."""
+        rows = np.searchsorted(self._w.leaf, leaf)
+        return pattern_at(geometry, self._w.models, self._wp, rows, points)

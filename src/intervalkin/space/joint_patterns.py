@@ -1,0 +1,265 @@
+"""Window patterns: the pieces of a window-modelled leaf told apart by where their roots are.
+
+A window model of a leaf L (:mod:`intervalkin.solve.window_model`) cuts the circle of
+orientations at points where the sign of f is proved for all of L; between them, arcs whose
+roots are fixed on L and *windows* where roots may merge.  Windows joined by inner cuts whose
+sign is only proved at points (sub-windows) are taken together: a *super-window* is a maximal
+run of them, and its two outer cuts have signs proved over L.
+
+At a point q of L off g(S) every solution is non-singular, so each moves continuously with q
+and never crosses a cut where f != 0 over L (f vanishes at a solution).  The number of
+solutions in each super-window is therefore locally constant on L minus g(S), and so is the
+*pattern*, the vector of those numbers.  The set of points of L off g(S) with a given pattern is
+open and closed in L minus g(S): a union of its connected pieces.  Two sets with the same total
+count but different patterns (near a transversal crossing of two sheets of g(S): two roots in
+one window, or two in the other) are told apart, though neither is proved connected
+(proofs/lemma-separation.md).
+
+Codes: a pattern is stored as sum over super-windows s of count_s * 8^rank_s, rank_s the
+position of s among its leaf's super-windows (counts below 8: a window holds at most 3 roots,
+a super-window at most 7 by construction of the codes; more is refused).
+
+Neighbours (:func:`compatible`): the orientation phi is the same coordinate in every leaf, so at a
+point q of a face shared by leaves L and L' every solution lies in one *unit* of each model: a
+super-window (holding the pattern's number) or an arc off the windows that holds one fixed root
+(the rest of the circle holds none, on the whole leaf).  A solution in a unit U' of L' lies in a
+unit of L whose arc meets U'.  Hence, for patterns k of L and k' of L' both held at q,
+
+    k'(U') <= sum of k(U) over the units U of L that meet U',
+
+and the same with L and L' exchanged.  A pair of patterns that breaks one of these inequalities
+is never held at one point: no path crosses the face from the one to the other.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import PI_HI
+from intervalkin.solve.window_count import window_root_counts
+from intervalkin.solve.window_model import WindowModels
+
+__all__ = ["WindowPatterns", "window_patterns", "pattern_at", "digits", "unit_overlaps", "unit_counts", "compatible"]
+
+#: Base of the pattern codes (one digit per super-window).
+BASE = 8
+
+
+@dataclass(frozen=True, eq=False)
+class WindowPatterns:
+    """The possible patterns of the boxes of a :class:`WindowModels` (those with ``ok``).
+
+    super_of : (w,) the super-window of each window; rank : (s,) the rank of each super-window in
+    its box; box : (k,) the box of each pattern row; code : (k,) its code; count : (k,) its total
+    count (roots off the windows plus the pattern's).
+    """
+
+    super_of: np.ndarray
+    rank: np.ndarray
+    box: np.ndarray
+    code: np.ndarray
+    count: np.ndarray
+
+
+def _window_sets(models: WindowModels) -> np.ndarray:
+    """(w,) int64 bit masks of the root counts each window can hold on its whole box."""
+    ends = models.end_signs.astype(np.int64)
+    # parity from the end signs only where D keeps one sign (a zero of D is a double root of f, no solution)
+    firm = (ends != 0).all(axis=1) & (models.d_sign != 0)
+    even = firm & (ends[:, 0] == ends[:, 1])
+    odd = firm & ~even
+    deg = models.degree.astype(np.int64)
+    every = np.left_shift(1, deg + 1) - 1  # 0 .. degree
+    return np.where(even, every & 0b0101_0101, np.where(odd, every & 0b1010_1010, every))
+
+
+def _super_windows(models: WindowModels) -> np.ndarray:
+    """(w,) super-window id of each window: windows linked by a cut whose sign is proved only at points."""
+    w = len(models.degree)
+    if w == 0:
+        return np.zeros(0, dtype=np.int64)
+    pw = models.piece_window
+    first = np.searchsorted(pw, np.arange(w), side="left")
+    last = np.searchsorted(pw, np.arange(w), side="right") - 1
+    start, stop = models.piece_lo[first], models.piece_hi[last]
+    box = models.window_box
+    # an inner cut is the stop of one window and the start of the next (the seam +-PI_HI is one cut)
+    key_stop = np.where(np.abs(stop) == PI_HI, -PI_HI, stop)
+    key_start = np.where(np.abs(start) == PI_HI, -PI_HI, start)
+    inner = np.flatnonzero(models.end_signs[:, 1] == 0)
+    a_keys = np.column_stack([box.astype(np.float64), key_start])
+    order = np.lexsort((a_keys[:, 1], a_keys[:, 0]))
+    sorted_keys = a_keys[order]
+    probe = np.column_stack([box[inner].astype(np.float64), key_stop[inner]])
+    # exact match of (box, phi) by a structured view
+    view = np.ascontiguousarray(sorted_keys).view([("b", "f8"), ("p", "f8")]).ravel()
+    pv = np.ascontiguousarray(probe).view([("b", "f8"), ("p", "f8")]).ravel()
+    pos = np.searchsorted(view, pv)
+    ok = pos < len(view)
+    ok[ok] = view[pos[ok]] == pv[ok]
+    if not ok.all():
+        raise ValueError("window model: an inner cut of a sub-window has no following sub-window")
+    nxt = order[pos]
+    graph = coo_matrix((np.ones(inner.size), (inner, nxt)), shape=(w, w))
+    return connected_components(graph, directed=False)[1].astype(np.int64)
+
+
+def window_patterns(models: WindowModels) -> WindowPatterns:
+    """Every pattern each modelled box may hold (the product of its super-windows' possible counts).
+
+    Boxes not modelled, or with a super-window that might hold more than 7 roots, get no rows.
+    """
+    sup = _super_windows(models)
+    nsup = int(sup.max()) + 1 if sup.size else 0
+    sets = _window_sets(models)
+    # the Minkowski sum of the members' sets, as bit masks (16 bits: a super-window over 7 is refused below)
+    ssets = np.ones(nsup, dtype=np.int64)
+    order = np.argsort(sup, kind="stable")
+    wrank = np.empty(len(sup), dtype=np.int64)
+    wrank[order] = np.arange(len(sup)) - np.searchsorted(sup[order], sup[order], side="left")
+    for r in range(int(wrank.max()) + 1 if len(sup) else 0):
+        at = np.flatnonzero(wrank == r)
+        grown = np.zeros(at.size, dtype=np.int64)
+        for bit in range(4):
+            grown |= np.where((sets[at] >> bit) & 1 == 1, ssets[sup[at]] << bit, 0)
+        ssets[sup[at]] = grown & 0xFFFF
+    sbox = np.zeros(nsup, dtype=np.int64)
+    sbox[sup] = models.window_box
+    order = np.argsort(sbox, kind="stable")
+    rank = np.empty(nsup, dtype=np.int64)
+    rank[order] = np.arange(nsup) - np.searchsorted(sbox[order], sbox[order], side="left")
+    wide = np.zeros(len(models.ok), dtype=bool)  # a super-window that might hold 8 roots or more: no digit for it
+    wide[models.window_box[(ssets[sup] >> BASE) != 0]] = True
+    ssets &= (1 << BASE) - 1
+    ok = np.flatnonzero(models.ok & ~wide)
+    box, code, count = ok.copy(), np.zeros(ok.size, dtype=np.int64), models.off[ok, 0].astype(np.int64)
+    for r in range(int(rank.max()) + 1 if nsup else 0):
+        at = np.flatnonzero(rank == r)
+        mask_of = np.zeros(len(models.ok), dtype=np.int64)
+        has = np.zeros(len(models.ok), dtype=bool)
+        mask_of[sbox[at]], has[sbox[at]] = ssets[at], True
+        rows_b, rows_c, rows_n = [box[~has[box]]], [code[~has[box]]], [count[~has[box]]]
+        for c in range(8):
+            take = has[box] & ((mask_of[box] >> c) & 1 == 1)
+            rows_b.append(box[take])
+            rows_c.append(code[take] + c * BASE ** r)
+            rows_n.append(count[take] + c)
+        box, code, count = np.concatenate(rows_b), np.concatenate(rows_c), np.concatenate(rows_n)
+    order = np.lexsort((code, box))
+    return WindowPatterns(sup, rank, box[order], code[order], count[order])
+
+
+def pattern_at(geometry: Geometry, models: WindowModels, patterns: WindowPatterns, rows: np.ndarray,
+               points: np.ndarray) -> np.ndarray:
+    """(m,) int64: the certified pattern code at joint vectors ``points`` of boxes ``rows``; -1 where undecided."""
+    rows = np.asarray(rows, dtype=np.int64)
+    out = np.full(len(rows), -1, dtype=np.int64)
+    if len(rows) == 0:
+        return out
+    counts = window_root_counts(geometry, models, rows, points)
+    digit = counts.roots[:, 0] * BASE ** patterns.rank[patterns.super_of[counts.win]]
+    code = np.bincount(counts.pt, weights=digit, minlength=counts.live.size).astype(np.int64)
+    good = counts.decided()
+    out[counts.live[good]] = code[good]
+    return out
+
+
+def digits(patterns: WindowPatterns, code: np.ndarray) -> np.ndarray:
+    """(m, K) int64: the count in each super-window (by rank) of the pattern codes ``code``."""
+    width = int(patterns.rank.max()) + 1 if patterns.rank.size else 1
+    return (np.asarray(code, dtype=np.int64)[:, None] // BASE ** np.arange(width)) % BASE
+
+
+def _arcs(start: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(k, 2) lo and hi of arcs from ``start`` to ``stop`` in circle order, as at most two closed intervals of
+    [-PI_HI, PI_HI] (NaN: none); an arc with stop <= start runs across phi = pi (all the way round if equal)."""
+    wraps = stop <= start
+    lo = np.column_stack([start, np.where(wraps, -PI_HI, np.nan)])
+    hi = np.column_stack([np.where(wraps, PI_HI, stop), np.where(wraps, stop, np.nan)])
+    return lo, hi
+
+
+def _units(models: WindowModels, patterns: WindowPatterns) -> tuple[np.ndarray, ...]:
+    """The arcs that hold roots, sorted by box: windows (unit: their super-window's rank) and fixed-root
+    arcs (unit: K + their position in the box).  Returns box, unit, lo (k, 2), hi (k, 2), and (n,) the number
+    of fixed-root arcs of each box."""
+    width = int(patterns.rank.max()) + 1 if patterns.rank.size else 1
+    w = len(models.degree)
+    pw = models.piece_window
+    first = np.searchsorted(pw, np.arange(w), side="left")
+    last = np.searchsorted(pw, np.arange(w), side="right") - 1
+    wlo, whi = _arcs(models.piece_lo[first], models.piece_hi[last])
+    rb = models.root_box
+    pos = np.arange(rb.size) - np.searchsorted(rb, rb, side="left")
+    rlo, rhi = _arcs(models.root_lo, models.root_hi)
+    box = np.r_[models.window_box, rb]
+    unit = np.r_[patterns.rank[patterns.super_of], width + pos]
+    order = np.argsort(box, kind="stable")
+    lo, hi = np.r_[wlo, rlo][order], np.r_[whi, rhi][order]
+    return box[order], unit[order], lo, hi, np.bincount(rb, minlength=len(models.ok))
+
+
+def unit_overlaps(models: WindowModels, patterns: WindowPatterns, box_a: np.ndarray,
+                  box_b: np.ndarray) -> np.ndarray:
+    """(c, U, U) bool: whether unit i of box_a[c] and unit j of box_b[c] may share an orientation.
+
+    Units: the super-windows (by rank, 0 .. K-1), then the fixed-root arcs (K, K + 1, ...).  Arcs are
+    closed, and every arc that reaches the seam phi = +-pi is taken to meet every other that does
+    (so an overlap is never missed; a spurious one only weakens :func:`compatible`).
+    """
+    box_a, box_b = np.asarray(box_a, dtype=np.int64), np.asarray(box_b, dtype=np.int64)
+    box, unit, lo, hi, n_roots = _units(models, patterns)
+    size = int(unit.max()) + 1 if unit.size else 1
+    out = np.zeros((box_a.size, size, size), dtype=bool)
+    if box_a.size == 0 or box.size == 0:
+        return out
+    sa = np.searchsorted(box, box_a, side="left")
+    na = np.searchsorted(box, box_a, side="right") - sa
+    sb = np.searchsorted(box, box_b, side="left")
+    nb = np.searchsorted(box, box_b, side="right") - sb
+    c = np.repeat(np.arange(box_a.size), na * nb)  # every (contact, arc of a, arc of b)
+    k = np.arange(c.size) - np.repeat(np.cumsum(na * nb) - na * nb, na * nb)
+    ua = sa[c] + k // np.maximum(nb[c], 1)
+    ub = sb[c] + k % np.maximum(nb[c], 1)
+    meet = np.zeros(c.size, dtype=bool)
+    for i in (0, 1):
+        for j in (0, 1):
+            meet |= np.maximum(lo[ua, i], lo[ub, j]) <= np.minimum(hi[ua, i], hi[ub, j])  # NaN compares False
+    seam_a = (np.nanmax(hi[ua], axis=1) >= PI_HI) | (np.nanmin(lo[ua], axis=1) <= -PI_HI)
+    seam_b = (np.nanmax(hi[ub], axis=1) >= PI_HI) | (np.nanmin(lo[ub], axis=1) <= -PI_HI)
+    meet |= seam_a & seam_b
+    out[c[meet], unit[ua[meet]], unit[ub[meet]]] = True
+    return out
+
+
+def unit_counts(models: WindowModels, patterns: WindowPatterns, row: np.ndarray, size: int) -> np.ndarray:
+    """(m, size) int64: the roots in each unit of the box of pattern rows ``row`` under that pattern."""
+    d = digits(patterns, patterns.code[row])
+    width = d.shape[1]
+    n_roots = np.bincount(models.root_box, minlength=len(models.ok))[patterns.box[row]]
+    out = np.zeros((len(row), max(size, width)), dtype=np.int64)
+    out[:, :width] = d
+    out[:, width:] = np.arange(out.shape[1] - width) < n_roots[:, None]
+    return out[:, :size] if size >= width else out
+
+
+def compatible(models: WindowModels, patterns: WindowPatterns, row_a: np.ndarray, row_b: np.ndarray,
+               overlap: np.ndarray) -> np.ndarray:
+    """(m,) bool: pattern rows row_a[i] and row_b[i] of two boxes sharing a face may be held at one point of it.
+
+    ``overlap`` (m, U, U): :func:`unit_overlaps` of the two rows' boxes.  False only where the roots of
+    one unit cannot all fit in the units of the other box that meet it (module docstring), which proves
+    that the two patterns never meet.
+    """
+    size = overlap.shape[1]
+    ca = unit_counts(models, patterns, row_a, size)
+    cb = unit_counts(models, patterns, row_b, size)
+    ov = overlap.astype(np.int64)
+    room_b = np.einsum("mi,mij->mj", ca, ov)
+    room_a = np.einsum("mj,mij->mi", cb, ov)
+    return np.all(cb <= room_b, axis=1) & np.all(ca <= room_a, axis=1)
