@@ -44,7 +44,8 @@ from intervalkin.core.interval import PI_HI
 from intervalkin.solve.window_count import window_root_counts
 from intervalkin.solve.window_model import WindowModels
 
-__all__ = ["WindowPatterns", "window_patterns", "pattern_at", "digits", "unit_overlaps", "unit_counts", "compatible"]
+__all__ = ["WindowPatterns", "window_patterns", "pattern_at", "digits", "unit_overlaps", "unit_counts", "compatible",
+           "exclusive", "row_of", "NONE", "EVERY"]
 
 #: Base of the pattern codes (one digit per super-window).
 BASE = 8
@@ -259,7 +260,67 @@ def compatible(models: WindowModels, patterns: WindowPatterns, row_a: np.ndarray
     size = overlap.shape[1]
     ca = unit_counts(models, patterns, row_a, size)
     cb = unit_counts(models, patterns, row_b, size)
-    ov = overlap.astype(np.int64)
-    room_b = np.einsum("mi,mij->mj", ca, ov)
-    room_a = np.einsum("mj,mij->mi", cb, ov)
-    return np.all(cb <= room_b, axis=1) & np.all(ca <= room_a, axis=1)
+    ok = np.ones(len(ca), dtype=bool)
+    for u in range(size):  # a unit at a time: no (m, U, U) integer copy
+        room_b = (ca * overlap[:, :, u]).sum(axis=1)
+        room_a = (cb * overlap[:, u, :]).sum(axis=1)
+        ok &= (cb[:, u] <= room_b) & (ca[:, u] <= room_a)
+    return ok
+
+
+def row_of(patterns: WindowPatterns, box: np.ndarray, code: np.ndarray) -> np.ndarray:
+    """(m,) the pattern row of (box, code), -1 where ``code`` is negative or not a pattern of the box."""
+    box, code = np.asarray(box, dtype=np.int64), np.asarray(code, dtype=np.int64)
+    lo = np.searchsorted(patterns.box, box, side="left")
+    end = hi = np.searchsorted(patterns.box, box, side="right")
+    last = max(patterns.code.size - 1, 0)
+    while True:  # binary search on the codes of each box's run (rows sorted by box, then code), all at once
+        live = lo < hi
+        if not live.any():
+            break
+        mid = (lo + hi) // 2
+        below = live & (patterns.code[np.minimum(mid, last)] < code)
+        lo, hi = np.where(below, mid + 1, lo), np.where(live & ~below, mid, hi)
+    found = (lo < end) & (code >= 0)
+    found[found] = patterns.code[lo[found]] == code[found]
+    return np.where(found, lo, -1)
+
+
+#: In the ``only`` arrays of :func:`exclusive`: this slot holds no point of the count; any pattern of it.
+NONE, EVERY = -1, -2
+
+
+def exclusive(models: WindowModels, patterns: WindowPatterns, box_a: np.ndarray, box_b: np.ndarray,
+              count: int, only_a: np.ndarray | None = None, only_b: np.ndarray | None = None) -> np.ndarray:
+    """(m,) bool: no point of the face shared by boxes box_a[i] and box_b[i] has ``count`` solutions.
+
+    True when both boxes have patterns (modelled) and no pattern of total ``count`` of the one is
+    :func:`compatible` with one of the other: a point with that count holds one such pattern in each box.
+    ``only_a`` (m, k): where a box's points with the count can only hold some patterns (a connected piece
+    of the box off g(S) holds one), those rows; :data:`NONE` for an unused slot, :data:`EVERY` for a
+    slot that may hold any pattern (the default).
+    """
+    box_a, box_b = np.asarray(box_a, dtype=np.int64), np.asarray(box_b, dtype=np.int64)
+    pb = patterns.box
+    has = np.zeros(len(models.ok), dtype=bool)
+    has[pb] = True
+    first_a, n_a = np.searchsorted(pb, box_a, side="left"), np.searchsorted(pb, box_a, side="right")
+    first_b, n_b = np.searchsorted(pb, box_b, side="left"), np.searchsorted(pb, box_b, side="right")
+    n_a, n_b = n_a - first_a, n_b - first_b
+    # every (contact, row of a, row of b), then only the rows with the count that each end allows
+    c = np.repeat(np.arange(box_a.size), n_a * n_b)
+    k = np.arange(c.size) - np.repeat(np.cumsum(n_a * n_b) - n_a * n_b, n_a * n_b)
+    ra = first_a[c] + k // np.maximum(n_b[c], 1)
+    rb = first_b[c] + k % np.maximum(n_b[c], 1)
+    keep = (patterns.count[ra] == count) & (patterns.count[rb] == count)
+    for only, r in ((only_a, ra), (only_b, rb)):
+        if only is not None:
+            only = np.asarray(only, dtype=np.int64)
+            keep &= (only[c] == EVERY).any(axis=1) | (only[c] == r[:, None]).any(axis=1)
+    c, ra, rb = c[keep], ra[keep], rb[keep]
+    meet = np.zeros(box_a.size, dtype=bool)
+    if c.size:
+        uniq, inv = np.unique(c, return_inverse=True)
+        ov = unit_overlaps(models, patterns, box_a[uniq], box_b[uniq])
+        meet[c[compatible(models, patterns, ra, rb, ov[inv])]] = True
+    return has[box_a] & has[box_b] & ~meet

@@ -44,7 +44,8 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.paving.adjacency import shares_face
 from intervalkin.solve.window_fold import CLEAR, FOLD
 from intervalkin.space.joint_closure import decided_traces, piece_cells
-from intervalkin.space.joint_patterns import compatible, pattern_at, unit_overlaps, window_patterns
+from intervalkin.space.joint_pattern_nodes import PatternNodes, expand
+from intervalkin.space.joint_refutation import Refuter, near_shortest
 
 __all__ = ["Separation", "separated_cells", "leaf_signatures", "possible_counts"]
 
@@ -53,6 +54,8 @@ _NOWRAP = (False, False, False)
 NO_PIECE, UNKNOWN = -2, -1
 #: Possible-count mask of a leaf that may hold any count.
 ANY = -1
+#: Rounds of window models on the shortest chains joining two cells of one signature (joint_refutation).
+REFUTE_ROUNDS = 6
 
 
 @dataclass(frozen=True)
@@ -177,173 +180,180 @@ def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return connected_components(graph, directed=False)[1]
 
 
-def _runs(keys: np.ndarray, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(start, length) of the run of each ``wanted`` value in the sorted array ``keys``."""
-    lo = np.searchsorted(keys, wanted, side="left")
-    return lo, np.searchsorted(keys, wanted, side="right") - lo
+def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Separation:
+    """The cells of a joint paving grouped, signature by signature, by the components of G_sigma (module docstring).
 
-
-def _expand(src: np.ndarray, start: np.ndarray, length: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs (src[i], start[i] + j) for j < length[i]."""
-    rep = np.repeat(np.arange(src.size), length)
-    return src[rep], start[rep] + np.arange(rep.size) - np.repeat(np.cumsum(length) - length, length)
-
-
-def separated_cells(jp, geometry: Geometry) -> Separation:
-    """The cells of a joint paving grouped, signature by signature, by the components of G_sigma (module docstring)."""
-    p = jp.paving
-    n = len(jp.cell)
-    every = jp.cells + jp.fragments
-    sig = leaf_signatures(jp)
-    counts = possible_counts(jp)
-    has_model = (sig[:, :, 0] != NO_PIECE).any(axis=1)
-    cells, _ = piece_cells(jp)
-    a, b = shares_face(p.level, p.ijk, int(p.level.max()), periodic=_NOWRAP)
-    pat = _Patterns(jp, has_model, counts)
-    is_p = pat.is_p
-    # the traces of the ends that may decide them, once for every signature
-    look = (_worth_deciding(sig, cells, a, b) & ~is_p[a] & ~is_p[b]) | (is_p[a] ^ is_p[b])
-    c = np.flatnonzero(look)
-    flo, fhi = np.maximum(p.lo[a[c]], p.lo[b[c]]), np.minimum(p.hi[a[c]], p.hi[b[c]])
-    trace = np.full((a.size, 2, 2), -1, dtype=np.int8)  # (contact, end a/b, piece): 1, 0 empty, -1 not decided
-    where = np.full((a.size, 2, 2, 3), np.nan)
-    for end, leaf in enumerate((a[c], b[c])):
-        solid = ~is_p[leaf]
-        trace[c[solid], end], where[c[solid], end] = decided_traces(jp, geometry, leaf[solid], flo[solid], fhi[solid])
-    # contacts of a pattern leaf L with a solid end E: the pattern of L at E's trace points
-    mixed = np.flatnonzero(is_p[a] ^ is_p[b])
-    e_end = np.where(is_p[a[mixed]], 1, 0)
-    e_leaf, l_leaf = np.where(e_end == 1, b[mixed], a[mixed]), np.where(e_end == 1, a[mixed], b[mixed])
-    e_trace, e_where = trace[mixed, e_end], where[mixed, e_end]
-    code_at = np.full((mixed.size, 2), -1, dtype=np.int64)
-    for slot in (0, 1):
-        at = np.flatnonzero(e_trace[:, slot] == 1)
-        code_at[at, slot] = pat.at(geometry, l_leaf[at], e_where[at, slot])
-    both = np.flatnonzero(is_p[a] & is_p[b])
-    overlap = pat.overlaps(a[both], b[both])
+    ``rounds``: while a group holds two cells, up to this many rounds of window models on the edges of
+    the shortest chains between them (:mod:`intervalkin.space.joint_refutation`); 0 for none.
+    """
+    g = _Graph(jp, geometry)
+    refuter = Refuter(geometry, jp.paving.lo, jp.paving.hi)
     groups: dict[tuple[int, int, int], tuple[tuple[int, ...], ...]] = {}
-    for s in sorted({c.signature for c in every}):
-        mine = [c for c in every if c.signature == s]
-        target = np.array(s, dtype=np.int64)
-        may = (sig == target).all(axis=2) | (sig[:, :, 0] == UNKNOWN)  # (n, 2) pieces that may carry s
+    size = g.n + len(g.pat.count)
+    for s in sorted({c.signature for c in g.every}):
+        mine = [c for c in g.every if c.signature == s]
+        all_src, all_dst = g.edges(s)
+        all_key = np.minimum(all_src, all_dst) * size + np.maximum(all_src, all_dst)
+        cut = np.zeros(all_key.size, dtype=bool)
+        tried = np.zeros(all_key.size, dtype=bool)
+        for round_ in range(rounds + 1):
+            src, dst = all_src[~cut], all_dst[~cut]
+            comp = _components(size, src, dst)
+            by_comp: dict[int, list[int]] = {}
+            for c in mine:
+                leaves = g.leaves_of[c.id]
+                if np.unique(comp[leaves]).size != 1:
+                    raise AssertionError(f"soundness bug: cell {c.id} is not inside one component of G_sigma "
+                                         f"for its signature {s}")
+                by_comp.setdefault(int(comp[leaves[0]]), []).append(c.id)
+            merged = [cs for cs in by_comp.values() if len(cs) > 1]
+            if not merged or round_ == rounds:
+                break
+            fresh = np.zeros(all_key.size, dtype=bool)
+            for cs in merged:
+                live = np.flatnonzero(~cut & ~tried & (all_src < g.n) & ~g.inside(all_src, all_dst, s))
+                goal = np.concatenate([g.leaves_of[c] for c in cs[1:]])
+                pick = live[near_shortest(size, src, dst, g.leaves_of[cs[0]], goal, all_src[live], all_dst[live])]
+                tried[pick] = True
+                fresh[pick[g.refute(refuter, all_src[pick], all_dst[pick], s)]] = True
+            if not fresh.any():
+                break
+            cut |= fresh
+        groups[s] = tuple(tuple(sorted(cs)) for cs in sorted(by_comp.values()))
+    return Separation(groups)
+
+
+class _Graph:
+    """What the graphs G_sigma share: the leaves, their models and traces, the pattern nodes."""
+
+    def __init__(self, jp, geometry: Geometry):
+        p = jp.paving
+        self.n = n = len(jp.cell)
+        self.every = jp.cells + jp.fragments
+        self.sig = sig = leaf_signatures(jp)
+        self.counts = possible_counts(jp)
+        self.has_model = (sig[:, :, 0] != NO_PIECE).any(axis=1)
+        self.cells = cells = piece_cells(jp)[0]
+        self.cell_sig = np.full((max(c.id for c in self.every) + 1, 3), -9, dtype=np.int64)
+        for c in self.every:
+            self.cell_sig[c.id] = c.signature
+        # a point of each connected piece of a leaf with a complete model: a clear leaf's centre, a fold piece's witness
+        self.points = np.full((n, 2, 3), np.nan)
+        clear = jp.cell >= 0
+        self.points[clear, 0] = 0.5 * (p.lo[clear] + p.hi[clear])
+        if jp.pieces is not None and len(jp.pieces):
+            self.points[jp.pieces.box] = jp.pieces.witness.reshape(-1, 2, 3)
+        self.leaves_of = {c.id: np.flatnonzero((cells == c.id).any(axis=1)) for c in self.every}
+        self.a, self.b = a, b = shares_face(p.level, p.ijk, int(p.level.max()), periodic=_NOWRAP)
+        self.pat = pat = PatternNodes(jp, self.has_model, self.counts)
+        is_p = pat.is_p
+        # the traces of the ends that may decide them, once for every signature
+        look = (_worth_deciding(sig, cells, a, b) & ~is_p[a] & ~is_p[b]) | (is_p[a] ^ is_p[b])
+        c = np.flatnonzero(look)
+        flo, fhi = np.maximum(p.lo[a[c]], p.lo[b[c]]), np.minimum(p.hi[a[c]], p.hi[b[c]])
+        self.trace = trace = np.full((a.size, 2, 2), -1, dtype=np.int8)  # (contact, end, piece): 1, 0 empty, -1
+        where = np.full((a.size, 2, 2, 3), np.nan)
+        for end, leaf in enumerate((a[c], b[c])):
+            solid = ~is_p[leaf]
+            trace[c[solid], end], where[c[solid], end] = decided_traces(jp, geometry, leaf[solid], flo[solid],
+                                                                        fhi[solid])
+        # contacts of a pattern leaf L with a solid end E: the pattern of L at E's trace points
+        mixed = np.flatnonzero(is_p[a] ^ is_p[b])
+        e_end = np.where(is_p[a[mixed]], 1, 0)
+        self.e_leaf = np.where(e_end == 1, b[mixed], a[mixed])
+        self.l_leaf = np.where(e_end == 1, a[mixed], b[mixed])
+        self.e_trace, e_where = trace[mixed, e_end], where[mixed, e_end]
+        self.code_at = np.full((mixed.size, 2), -1, dtype=np.int64)  # -1: joined to every pattern of the count
+        for slot in (0, 1):
+            c_e = sig[self.e_leaf, slot, 0]
+            # a piece of certified count c whose neighbour holds one pattern of count c needs no evaluation
+            ambiguous = (c_e == UNKNOWN) | (pat.rows_with(self.l_leaf, np.maximum(c_e, 0)) > 1)
+            at = np.flatnonzero((self.e_trace[:, slot] == 1) & ambiguous)
+            self.code_at[at, slot] = pat.at(geometry, self.l_leaf[at], e_where[at, slot])
+        self.both = np.flatnonzero(is_p[a] & is_p[b])
+        self.overlap = pat.overlaps(a[self.both], b[self.both])
+
+    def may(self, s: tuple[int, int, int]) -> np.ndarray:
+        """(n, 2) bool: the pieces of the leaves with a complete model that may carry signature s."""
+        return (self.sig == np.array(s, dtype=np.int64)).all(axis=2) | (self.sig[:, :, 0] == UNKNOWN)
+
+    def inside(self, u: np.ndarray, v: np.ndarray, s: tuple[int, int, int]) -> np.ndarray:
+        """(m,) bool: edges between two leaves that both hold pieces of one cell of signature s (cutting them
+        separates nothing: a cell's leaves are one component); pattern nodes (>= n) hold no cell."""
+        same = np.zeros(u.size, dtype=bool)
+        both = np.flatnonzero((u < self.n) & (v < self.n))
+        ca, cb = self.cells[u[both]], self.cells[v[both]]
+        for i in (0, 1):
+            for j in (0, 1):
+                same[both] |= ((ca[:, i] >= 0) & (ca[:, i] == cb[:, j])
+                               & (self.cell_sig[np.maximum(ca[:, i], 0)] == s).all(axis=1))
+        return same
+
+    def refute(self, refuter: Refuter, u: np.ndarray, v: np.ndarray, s: tuple[int, int, int]) -> np.ndarray:
+        """(m,) bool: edges (u leaf, v leaf or pattern node) that window models of both ends prove to carry no
+        point with s's count (the pieces of a leaf with a complete model each hold the pattern at its point,
+        a pattern node its own)."""
+        # a leaf without a complete model may hold any pattern: one slot, no point
+        whole = np.array([True, False])
+        may = np.where(self.has_model[:, None], self.may(s), whole)
+        node = v >= self.n
+        leaf_v = np.where(node, self.pat.leaf[np.where(node, v - self.n, 0)], v)
+        code_v = np.where(node, self.pat.code[np.where(node, v - self.n, 0)], -1)
+        pts_v = np.where(node[:, None, None], np.nan, self.points[leaf_v])
+        may_v = np.where(node[:, None], whole, may[leaf_v])
+        return refuter.cut(u, leaf_v, s[0], (self.points[u], pts_v), (may[u], may_v), code_v)
+
+    def edges(self, s: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
+        """The edges (src, dst) of G_sigma for sigma = ``s`` (nodes: the leaves, then n + the pattern nodes;
+        src is a leaf wherever one end is)."""
+        n, a, b, sig, pat = self.n, self.a, self.b, self.sig, self.pat
+        is_p, has_model, counts = pat.is_p, self.has_model, self.counts
+        may = self.may(s)  # (n, 2) pieces that may carry s
         admit = ~is_p & np.where(has_model, may.any(axis=1), (counts == ANY) | ((counts >> s[0]) & 1 == 1))
+        for c in self.every:
+            if c.signature == s and not admit[self.leaves_of[c.id]].all():
+                raise AssertionError(f"soundness bug: a leaf of cell {c.id} does not admit its signature {s}")
         # solid-solid contacts: cut when an end decides its traces and each of its pieces that may carry s is empty
         keep = admit[a] & admit[b]
         for end, leaf in enumerate((a, b)):
             m = may[leaf]
-            empty = (trace[:, end] == 0) | ~m
+            empty = (self.trace[:, end] == 0) | ~m
             keep &= ~(has_model[leaf] & m.any(axis=1) & empty.all(axis=1))
         src, dst = [a[keep]], [b[keep]]
         start, length, sel = pat.rows(s[0])
         # solid-pattern contacts: the pattern found at a trace point, or every pattern with the count
+        e_leaf, l_leaf, e_trace = self.e_leaf, self.l_leaf, self.e_trace
         m = may[e_leaf] & has_model[e_leaf, None]
         deciding = has_model[e_leaf] & np.all((e_trace != -1) | ~m, axis=1)
         for slot in (0, 1):
             hit = np.flatnonzero(admit[e_leaf] & deciding & m[:, slot] & (e_trace[:, slot] == 1))
-            row = pat.row_of(l_leaf[hit], code_at[hit, slot])
+            row = pat.row_of(l_leaf[hit], self.code_at[hit, slot])
             known = row >= 0
             other = known & (pat.count[np.maximum(row, 0)] != s[0])
             if np.any(other & (sig[e_leaf[hit], slot, 0] == s[0])):
                 bad = hit[other & (sig[e_leaf[hit], slot, 0] == s[0])][:3]
                 raise AssertionError("soundness bug: a trace point of one signature has a pattern of another count "
                                      f"(contacts {e_leaf[bad].tolist()} / {l_leaf[bad].tolist()})")
-            known &= ~other  # a trace of unknown signature whose point has another count carries no s
-            hit = hit[known | (row < 0)]
-            row = row[known | (row < 0)]
+            # a trace of unknown signature whose point has another count carries no s
+            hit, row = hit[~other], row[~other]
             known = row >= 0
             src.append(e_leaf[hit[known]])
             dst.append(n + row[known])
-            blind = hit[~known]
-            x, y = _expand(e_leaf[blind], start[l_leaf[blind]], length[l_leaf[blind]])
+            x, y = expand(e_leaf[hit[~known]], start[l_leaf[hit[~known]]], length[l_leaf[hit[~known]]])
             src.append(x)
             dst.append(n + sel[y])
         blind = np.flatnonzero(admit[e_leaf] & ~deciding)
-        x, y = _expand(e_leaf[blind], start[l_leaf[blind]], length[l_leaf[blind]])
+        x, y = expand(e_leaf[blind], start[l_leaf[blind]], length[l_leaf[blind]])
         src.append(x)
         dst.append(n + sel[y])
         # pattern-pattern contacts: the pairs of patterns with the count that may meet on the face
-        i, ra = _expand(np.arange(both.size), start[a[both]], length[a[both]])
-        j, rb = _expand(np.arange(i.size), start[b[both[i]]], length[b[both[i]]])
+        both = self.both
+        i, ra = expand(np.arange(both.size), start[a[both]], length[a[both]])
+        j, rb = expand(np.arange(i.size), start[b[both[i]]], length[b[both[i]]])
         ga, gb = sel[ra[j]], sel[rb]
-        meet = pat.compatible(ga, gb, overlap[i[j]])
+        meet = pat.compatible(ga, gb, self.overlap[i[j]])
         src.append(n + ga[meet])
         dst.append(n + gb[meet])
-        comp = _components(n + len(pat.count), np.concatenate(src), np.concatenate(dst))
-        by_comp: dict[int, list[int]] = {}
-        for c in mine:
-            leaves = np.flatnonzero((cells == c.id).any(axis=1))
-            if not admit[leaves].all() or np.unique(comp[leaves]).size != 1:
-                raise AssertionError(f"soundness bug: cell {c.id} is not inside one component of G_sigma "
-                                     f"for its signature {s}")
-            by_comp.setdefault(int(comp[leaves[0]]), []).append(c.id)
-        groups[s] = tuple(tuple(sorted(g)) for g in sorted(by_comp.values()))
-    return Separation(groups)
+        return np.concatenate(src), np.concatenate(dst)
 
 
-class _Patterns:
-    """The pattern nodes of a paving: leaves with a window model and no complete model (module docstring of
-    :mod:`intervalkin.space.joint_patterns`), one node per pattern the leaf may hold."""
-
-    def __init__(self, jp, has_model: np.ndarray, counts: np.ndarray):
-        n = len(jp.cell)
-        self.is_p = np.zeros(n, dtype=bool)
-        self.count = np.zeros(0, dtype=np.int64)
-        self._leaf = np.zeros(0, dtype=np.int64)
-        self._code = np.zeros(0, dtype=np.int64)
-        self._row = np.zeros(0, dtype=np.int64)
-        w = jp.windows
-        if w is None:
-            return
-        self._w = w
-        self._wp = window_patterns(w.models)
-        leaf = w.leaf[self._wp.box]
-        # a leaf said to hold anything (counts ANY) stays one node, whatever its model
-        keep = ~has_model[leaf] & (counts[leaf] != ANY)
-        self._row = np.flatnonzero(keep)
-        self._leaf, self._code, self.count = leaf[keep], self._wp.code[keep], self._wp.count[keep]
-        self.is_p[self._leaf] = True
-
-    def overlaps(self, leaf_a: np.ndarray, leaf_b: np.ndarray) -> np.ndarray:
-        """(c, U, U) unit overlaps of pattern leaves sharing a face (see :func:`unit_overlaps`)."""
-        if self._leaf.size == 0:
-            return np.zeros((leaf_a.size, 1, 1), dtype=bool)
-        box_a, box_b = (np.searchsorted(self._w.leaf, x) for x in (leaf_a, leaf_b))
-        return unit_overlaps(self._w.models, self._wp, box_a, box_b)
-
-    def compatible(self, node_a: np.ndarray, node_b: np.ndarray, overlap: np.ndarray) -> np.ndarray:
-        """Whether pattern nodes node_a[i] and node_b[i] of two leaves sharing a face may meet on it."""
-        return compatible(self._w.models, self._wp, self._row[node_a], self._row[node_b], overlap)
-
-    def rows(self, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The rows with ``count``, compacted: (n,) start and length of each leaf's run among them, and the
-        global row of each compacted one."""
-        n = len(self.is_p)
-        sel = self.count == count
-        start = np.zeros(n, dtype=np.int64)
-        length = np.zeros(n, dtype=np.int64)
-        if self._leaf.size:
-            leaves = np.flatnonzero(self.is_p)
-            first, size = _runs(self._leaf, leaves)
-            before = np.r_[0, np.cumsum(sel)]
-            # rows with the count are not contiguous inside a leaf's run: index them through a compacted view
-            start[leaves] = before[first]
-            length[leaves] = before[first + size] - before[first]
-        return start, length, np.flatnonzero(sel)
-
-    def row_of(self, leaf: np.ndarray, code: np.ndarray) -> np.ndarray:
-        """Row of (leaf, code), -1 where code is -1 or not a row."""
-        out = np.full(leaf.size, -1, dtype=np.int64)
-        if self._leaf.size == 0 or leaf.size == 0:
-            return out
-        first, size = _runs(self._leaf, leaf)
-        for k in range(int(size.max()) if size.size else 0):  # a leaf has a few patterns: scan them
-            hit = (k < size) & (out < 0) & (code >= 0)
-            idx = np.where(hit, first + k, 0)
-            ok = hit & (self._code[idx] == code)
-            out[ok] = idx[ok]
-        return out
-
-    def at(self, geometry: Geometry, leaf: np.ndarray, points: np.ndarray) -> np.ndarray:
-        """The certified pattern code of ``leaf`` at ``points`` (-1 where undecided)."""
-        rows = np.searchsorted(self._w.leaf, leaf)
-        return pattern_at(geometry, self._w.models, self._wp, rows, points)
