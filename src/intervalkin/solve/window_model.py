@@ -285,7 +285,8 @@ def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, de
     loose = ~pair & ~triple
     degree = np.select([pair, triple, loose & (f2 != 0), loose & (f3 != 0)], [2, 3, 2, 3], 0)
     d_sign = np.select([pair, triple], [d2, d3], np.where(d2 != 0, d2, d3))
-    w_first, w_last = np.r_[True, pw[1:] != pw[:-1]], np.r_[pw[1:] != pw[:-1], True]
+    # a chunk with no window at all (boxes clear of g(S)) has no pieces here
+    w_first, w_last = np.r_[True, pw[1:] != pw[:-1]][:n_p], np.r_[pw[1:] != pw[:-1], True][:n_p]
     split = np.flatnonzero(degree[pw] == 0)
     starts, order, failed = sub_windows(pw[split], np.stack([np.where(kind[sel] == 1, sign[sel], 0), f2p, f3p])[:, split])
     run_start, p_degree = w_first.copy(), degree[pw]

@@ -70,6 +70,8 @@ class PatternNodes:
 
     def compatible(self, node_a: np.ndarray, node_b: np.ndarray, overlap: np.ndarray) -> np.ndarray:
         """Whether pattern nodes node_a[i] and node_b[i] of two leaves sharing a face may meet on it."""
+        if self.leaf.size == 0:
+            return np.zeros(0, dtype=bool)
         return compatible(self._w.models, self._wp, self._row[node_a], self._row[node_b], overlap)
 
     def rows(self, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -123,5 +125,7 @@ class PatternNodes:
 
     def at(self, geometry: Geometry, leaf: np.ndarray, points: np.ndarray) -> np.ndarray:
         """The certified pattern code of ``leaf`` at ``points`` (-1 where undecided)."""
+        if self.leaf.size == 0:
+            return np.full(len(leaf), -1, dtype=np.int64)
         rows = np.searchsorted(self._w.leaf, leaf)
         return pattern_at(geometry, self._w.models, self._wp, rows, points)

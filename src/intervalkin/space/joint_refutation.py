@@ -33,27 +33,48 @@ BATCH = 20000
 
 
 class Refuter:
-    """Window models of leaves of a joint paving, made on demand, and the contacts they cut."""
+    """Window models of leaves of a joint paving, made on demand, and the contacts they cut.
+
+    A leaf whose window model fails (a window that might hold too many roots, an arc with no signed
+    derivative) is modelled as its eight halves instead: a point of the leaf lies in one of them.
+    """
 
     def __init__(self, geometry: Geometry, lo: np.ndarray, hi: np.ndarray):
         self._geometry, self._lo, self._hi = geometry, lo, hi
-        self._inserted = np.zeros(0, dtype=np.int64)  # the modelled leaves, in the order of the models' rows
-        self._leaf = np.zeros(0, dtype=np.int64)  # the same, sorted; self._row: their rows
-        self._row = np.zeros(0, dtype=np.int64)
+        self._leaf = np.zeros(0, dtype=np.int64)  # the modelled leaves, sorted
+        self._row = np.zeros(0, dtype=np.int64)  # the models row of each (its own, or its first half's)
+        self._halves = np.zeros(0, dtype=bool)  # modelled as eight halves (rows row .. row + 7)
         self._models: WindowModels | None = None
         self._patterns = None
         self.modelled = 0
+
+    def _add(self, boxes: np.ndarray) -> np.ndarray:
+        """Model boxes (k, 3, 2); their rows."""
+        m = window_models(self._geometry, boxes)
+        first = 0 if self._models is None else len(self._models.ok)
+        self._models = m if self._models is None else self._models.concat(m)
+        return first + np.arange(len(boxes))
 
     def _model(self, leaves: np.ndarray) -> None:
         new = np.setdiff1d(leaves, self._leaf)
         if new.size == 0:
             return
-        m = window_models(self._geometry, np.stack([self._lo[new], self._hi[new]], axis=-1))
-        self._models = m if self._models is None else self._models.concat(m)
-        self._inserted = np.r_[self._inserted, new]  # leaf of each models row
-        self._row = np.argsort(self._inserted, kind="stable")
-        self._leaf = self._inserted[self._row]
+        lo, hi = self._lo[new], self._hi[new]
+        row = self._add(np.stack([lo, hi], axis=-1))
         self._patterns = window_patterns(self._models)
+        halves = ~np.isin(row, self._patterns.box)
+        if halves.any():
+            k = np.flatnonzero(halves)
+            mid = 0.5 * (lo[k] + hi[k])
+            corner = (np.arange(8)[:, None] >> np.arange(3)) & 1  # (8, 3): which half along each axis
+            c_lo = np.where(corner[None], mid[:, None], lo[k][:, None])
+            c_hi = np.where(corner[None], hi[k][:, None], mid[:, None])
+            row[k] = self._add(np.stack([c_lo, c_hi], axis=-1).reshape(-1, 3, 2))[::8]
+            self._patterns = window_patterns(self._models)
+        leaf = np.r_[self._leaf, new]
+        order = np.argsort(leaf, kind="stable")
+        self._leaf, self._row = leaf[order], np.r_[self._row, row][order]
+        self._halves = np.r_[self._halves, halves][order]
         self.modelled += int(new.size)
 
     def cut(self, a: np.ndarray, b: np.ndarray, count: int, points: tuple[np.ndarray, np.ndarray] | None = None,
@@ -64,23 +85,38 @@ class Refuter:
         none known), and ``may`` (m, 2) bool: the pieces that may hold the count.  A piece holds one
         pattern, the one found at its point; without them every pattern of the count is possible.
         ``code_b`` (m,): where not -1, b stands only for its points of that pattern (a pattern node).
+        A leaf modelled as halves has no such restriction: the contact is cut when every pair of a
+        half of the one end and a half (or the whole) of the other that meet is proved free of the count.
         """
         if a.size == 0:
             return np.zeros(0, dtype=bool)
         self._model(np.unique(np.r_[a, b]))
-        ra = self._row[np.searchsorted(self._leaf, a)]
-        rb = self._row[np.searchsorted(self._leaf, b)]
-        only = [None, None]
+        ia, ib = np.searchsorted(self._leaf, a), np.searchsorted(self._leaf, b)
+        ra, rb = self._row[ia], self._row[ib]
+        only = [np.full((a.size, 2), EVERY, dtype=np.int64), np.full((a.size, 2), EVERY, dtype=np.int64)]
         if points is not None:
-            for end, (rows, pts, m) in enumerate(zip((ra, rb), points, may)):
-                only[end] = self._piece_rows(rows, pts, m)
+            for end, (i, rows, pts, m) in enumerate(zip((ia, ib), (ra, rb), points, may)):
+                whole = np.where(self._halves[i][:, None, None], np.nan, pts)  # a half's model says nothing of pieces
+                only[end] = self._piece_rows(rows, whole, m)
         if code_b is not None:
             node = np.flatnonzero(code_b >= 0)
             row = row_of(self._patterns, rb[node], code_b[node])
-            if only[1] is None:
-                only[1] = np.full((a.size, 2), EVERY, dtype=np.int64)
             only[1][node] = np.column_stack([np.where(row >= 0, row, EVERY), np.full(node.size, NONE)])
-        return exclusive(self._models, self._patterns, ra, rb, count, only[0], only[1])
+        # every pair of parts (the leaf, or its halves) of the two ends whose closed boxes meet
+        na, nb = np.where(self._halves[ia], 8, 1), np.where(self._halves[ib], 8, 1)
+        c = np.repeat(np.arange(a.size), na * nb)
+        k = np.arange(c.size) - np.repeat(np.cumsum(na * nb) - na * nb, na * nb)
+        pa, pb = ra[c] + k // nb[c], rb[c] + k % nb[c]
+        boxes = self._models.boxes
+        meet = np.all(np.maximum(boxes[pa, :, 0], boxes[pb, :, 0]) <= np.minimum(boxes[pa, :, 1], boxes[pb, :, 1]),
+                      axis=1)
+        c, pa, pb = c[meet], pa[meet], pb[meet]
+        # a piece's pattern is a fact about its leaf's own model: halves may hold any pattern
+        oa = np.where(self._halves[ia][c, None], EVERY, only[0][c])
+        ob = np.where(self._halves[ib][c, None], EVERY, only[1][c])
+        free = exclusive(self._models, self._patterns, pa, pb, count, oa, ob)
+        held = np.bincount(c, weights=~free, minlength=a.size)
+        return (held == 0) & (np.bincount(c, minlength=a.size) > 0)
 
     def _piece_rows(self, rows: np.ndarray, pts: np.ndarray, may: np.ndarray) -> np.ndarray:
         """(m, 2) the pattern row of each piece that may hold the count (EVERY where not found), NONE elsewhere."""

@@ -184,8 +184,12 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
     """The cells of a joint paving grouped, signature by signature, by the components of G_sigma (module docstring).
 
     ``rounds``: while a group holds two cells, up to this many rounds of window models on the edges of
-    the shortest chains between them (:mod:`intervalkin.space.joint_refutation`); 0 for none.
+    the shortest chains between them (:mod:`intervalkin.space.joint_refutation`); 0 for none, and none on
+    a paving without window models (without pattern nodes the chains run through leaves that may hold
+    anything: on the paper's manipulator they raised no bound and took a minute).
     """
+    if jp.windows is None:
+        rounds = 0
     g = _Graph(jp, geometry)
     refuter = Refuter(geometry, jp.paving.lo, jp.paving.hi)
     groups: dict[tuple[int, int, int], tuple[tuple[int, ...], ...]] = {}
@@ -297,8 +301,9 @@ class _Graph:
         whole = np.array([True, False])
         may = np.where(self.has_model[:, None], self.may(s), whole)
         node = v >= self.n
-        leaf_v = np.where(node, self.pat.leaf[np.where(node, v - self.n, 0)], v)
-        code_v = np.where(node, self.pat.code[np.where(node, v - self.n, 0)], -1)
+        k = np.where(node, v - self.n, 0)
+        leaf_v, code_v = v.copy(), np.full(v.size, -1, dtype=np.int64)
+        leaf_v[node], code_v[node] = self.pat.leaf[k[node]], self.pat.code[k[node]]
         pts_v = np.where(node[:, None, None], np.nan, self.points[leaf_v])
         may_v = np.where(node[:, None], whole, may[leaf_v])
         return refuter.cut(u, leaf_v, s[0], (self.points[u], pts_v), (may[u], may_v), code_v)
