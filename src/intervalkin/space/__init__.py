@@ -10,6 +10,14 @@ joint_paving            joint space paved directly: boxes proved off g(S), adapt
 joint_cells             the cells of that paving, their certified counts, joins, regions from cells
 joint_pieces            the two pieces of each fold box (solve.fold_model) and the points that join them to cells
 joint_models            the local models of the undecided leaves (exclusion, fold), computed once per leaf
+joint_leaves            the leaves of that paving: bisection fronts, their tests, refinement
+joint_windows, joint_window_pieces   window models of the leaves left without a fold model; window-clear leaves and folds
+joint_places            the open places a joint paving leaves (where a cell could hide or a join be missing)
+joint_closure           closed cells: cells proved to be whole components of the joint box minus g(S)
+joint_separation        separations: cells of one signature proved to be different components (the graph G_sigma)
+joint_patterns          patterns: solutions per super-window of a window model; which two may meet on a face
+joint_pattern_nodes     window-modelled leaves as one node of G_sigma per possible pattern
+joint_refutation        contacts of G_sigma refuted by window models of both ends, on the shortest chains
 characteristic_surface  aspect boxes certified off S_c
 pieces, sheets, voxel_paths   pieces of certified boxes and the sheet above a cell each lies on
 basic_region            basic regions and basic components (Theorem 1, Proposition 1)

@@ -70,7 +70,8 @@ class WindowPatterns:
 def _window_sets(models: WindowModels) -> np.ndarray:
     """(w,) int64 bit masks of the root counts each window can hold on its whole box."""
     ends = models.end_signs.astype(np.int64)
-    # parity from the end signs only where D keeps one sign (a zero of D is a double root of f, no solution)
+    # parity from the end signs only where D keeps one sign: at a zero of D the roots of f and the
+    # solutions need not match one for one (proofs/lemma-window-patterns.md)
     firm = (ends != 0).all(axis=1) & (models.d_sign != 0)
     even = firm & (ends[:, 0] == ends[:, 1])
     odd = firm & ~even
@@ -128,7 +129,8 @@ def window_patterns(models: WindowModels) -> WindowPatterns:
         grown = np.zeros(at.size, dtype=np.int64)
         for bit in range(4):
             grown |= np.where((sets[at] >> bit) & 1 == 1, ssets[sup[at]] << bit, 0)
-        ssets[sup[at]] = grown & 0xFFFF
+        # counts of 16 or more only ever make a super-window "wide": keep that fact, not the bits
+        ssets[sup[at]] = (grown & 0xFFFF) | np.where(grown >> 16 != 0, 1 << 15, 0)
     sbox = np.zeros(nsup, dtype=np.int64)
     sbox[sup] = models.window_box
     order = np.argsort(sbox, kind="stable")
@@ -215,7 +217,8 @@ def unit_overlaps(models: WindowModels, patterns: WindowPatterns, box_a: np.ndar
     """
     box_a, box_b = np.asarray(box_a, dtype=np.int64), np.asarray(box_b, dtype=np.int64)
     box, unit, lo, hi, n_roots = _units(models, patterns)
-    size = int(unit.max()) + 1 if unit.size else 1
+    width = int(patterns.rank.max()) + 1 if patterns.rank.size else 1
+    size = max(int(unit.max()) + 1 if unit.size else 1, width)  # every super-window digit has a unit
     out = np.zeros((box_a.size, size, size), dtype=bool)
     if box_a.size == 0 or box.size == 0:
         return out
@@ -243,10 +246,12 @@ def unit_counts(models: WindowModels, patterns: WindowPatterns, row: np.ndarray,
     d = digits(patterns, patterns.code[row])
     width = d.shape[1]
     n_roots = np.bincount(models.root_box, minlength=len(models.ok))[patterns.box[row]]
-    out = np.zeros((len(row), max(size, width)), dtype=np.int64)
+    if size < width:
+        raise ValueError(f"unit_counts: {size} units cannot hold {width} super-windows")
+    out = np.zeros((len(row), size), dtype=np.int64)
     out[:, :width] = d
-    out[:, width:] = np.arange(out.shape[1] - width) < n_roots[:, None]
-    return out[:, :size] if size >= width else out
+    out[:, width:] = np.arange(size - width) < n_roots[:, None]
+    return out
 
 
 def compatible(models: WindowModels, patterns: WindowPatterns, row_a: np.ndarray, row_b: np.ndarray,

@@ -62,9 +62,14 @@ REFUTE_ROUNDS = 6
 class Separation:
     """groups : per signature (count, n_wa1, n_wa2), the cells of that signature grouped by the
     components of G_sigma that hold them; cells in different groups are proved to be different
-    components of the joint box minus g(S)."""
+    components of the joint box minus g(S).  pattern_nodes : nodes standing for a pattern of a
+    window-modelled leaf; refuted_contacts, leaves_modelled : edges cut by window models of both ends
+    in the refutation rounds, and the leaves given a window model for them."""
 
     groups: dict[tuple[int, int, int], tuple[tuple[int, ...], ...]]
+    pattern_nodes: int = 0
+    refuted_contacts: int = 0
+    leaves_modelled: int = 0
 
     def components_at_least(self) -> int:
         """A proved lower bound on the number of components of the joint box minus g(S) that hold a cell."""
@@ -80,10 +85,15 @@ class Separation:
                                  for sig, groups in sorted(self.groups.items())],
                 "components_at_least": self.components_at_least(),
                 "basic_regions_at_least": self.basic_regions_at_least(),
+                "pattern_nodes": self.pattern_nodes,
+                "refuted_contacts": self.refuted_contacts,
+                "leaves_modelled_for_refutation": self.leaves_modelled,
                 "certified": "cells in different groups of one signature are different components of the joint "
-                             "box minus g(S): no face contact chain of leaves that may hold that signature joins "
-                             "them (proofs/lemma-separation.md); not yet in the certificates, so the lower bounds "
-                             "printed elsewhere do not use it"}
+                             "box minus g(S): no chain of face contacts between leaves (or patterns of window-"
+                             "modelled leaves) that may hold that signature joins them (proofs/lemma-separation.md, "
+                             "lemma-window-patterns.md, lemma-refuted-contact.md); proved by the library, not yet in "
+                             "the certificates, so intervalkin verify does not re-prove it and the certified lower "
+                             "bounds printed elsewhere do not use it"}
 
 
 def leaf_signatures(jp) -> np.ndarray:
@@ -194,6 +204,7 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
     refuter = Refuter(geometry, jp.paving.lo, jp.paving.hi)
     groups: dict[tuple[int, int, int], tuple[tuple[int, ...], ...]] = {}
     size = g.n + len(g.pat.count)
+    refuted = 0
     for s in sorted({c.signature for c in g.every}):
         mine = [c for c in g.every if c.signature == s]
         all_src, all_dst = g.edges(s)
@@ -224,7 +235,8 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
                 break
             cut |= fresh
         groups[s] = tuple(tuple(sorted(cs)) for cs in sorted(by_comp.values()))
-    return Separation(groups)
+        refuted += int(cut.sum())
+    return Separation(groups, len(g.pat.count), refuted, refuter.modelled)
 
 
 class _Graph:
@@ -271,7 +283,8 @@ class _Graph:
         for slot in (0, 1):
             c_e = sig[self.e_leaf, slot, 0]
             # a piece of certified count c whose neighbour holds one pattern of count c needs no evaluation
-            ambiguous = (c_e == UNKNOWN) | (pat.rows_with(self.l_leaf, np.maximum(c_e, 0)) > 1)
+            # (none: a contradiction, evaluated so that the soundness check below sees it)
+            ambiguous = (c_e == UNKNOWN) | (pat.rows_with(self.l_leaf, np.maximum(c_e, 0)) != 1)
             at = np.flatnonzero((self.e_trace[:, slot] == 1) & ambiguous)
             self.code_at[at, slot] = pat.at(geometry, self.l_leaf[at], e_where[at, slot])
         self.both = np.flatnonzero(is_p[a] & is_p[b])
