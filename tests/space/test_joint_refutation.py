@@ -132,3 +132,38 @@ def test_rounds_only_split_groups(fold_paving, paper_geometry):
         for g in groups:
             assert any(set(g) <= c for c in coarse), (s, g, coarse)
     assert some.components_at_least() >= none.components_at_least()
+
+
+def test_a_piece_holds_the_one_pattern_its_probe_found(graph, fold_paving, paper_geometry):
+    # fold boxes with two pieces of certified counts: the pattern given to each piece (from its point, or from
+    # a probe of its count) is the pattern at every point of the leaf with that count
+    from intervalkin.space.joint_patterns import pattern_at
+
+    rng = np.random.default_rng(34)
+    two = np.flatnonzero((graph.sig[:, :, 0] >= 0).all(axis=1) & (graph.sig[:, 0, 0] != graph.sig[:, 1, 0]))
+    leaves = rng.choice(two, 150, replace=False)
+    refuter = Refuter(paper_geometry, fold_paving.paving.lo, fold_paving.paving.hi)
+    refuter._model(np.unique(leaves))
+    i = np.searchsorted(refuter._leaf, leaves)
+    whole = ~refuter._halves[i]
+    leaves, rows = leaves[whole], refuter._row[i[whole]]
+    pts = np.full((leaves.size, 2, 3), np.nan)  # no witness: every pattern comes from a probe
+    rows_of_piece = refuter._piece_rows(leaves, rows, pts, np.ones((leaves.size, 2), dtype=bool),
+                                        graph.sig[leaves, :, 0])
+    assert (rows_of_piece >= 0).sum() > 100
+    p = fold_paving.paving
+    checked = 0
+    for leaf, row, given in zip(leaves[:60], rows[:60], rows_of_piece[:60]):
+        q = p.lo[leaf] + rng.uniform(0.02, 0.98, (6, 3)) * (p.hi[leaf] - p.lo[leaf])
+        code = pattern_at(paper_geometry, refuter._models, refuter._patterns, np.full(6, row), q)
+        for x, c in zip(q, code):
+            if c < 0:
+                continue
+            n = solve(paper_geometry, [Fraction(float(v)) for v in x])
+            if not n.complete:
+                continue
+            for slot in (0, 1):
+                if given[slot] >= 0 and graph.sig[leaf, slot, 0] == n.count:
+                    checked += 1
+                    assert refuter._patterns.code[given[slot]] == c, (leaf, slot, n.count)
+    assert checked >= 60

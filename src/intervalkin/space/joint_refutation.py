@@ -78,13 +78,17 @@ class Refuter:
         self.modelled += int(new.size)
 
     def cut(self, a: np.ndarray, b: np.ndarray, count: int, points: tuple[np.ndarray, np.ndarray] | None = None,
-            may: tuple[np.ndarray, np.ndarray] | None = None, code_b: np.ndarray | None = None) -> np.ndarray:
+            may: tuple[np.ndarray, np.ndarray] | None = None, code_b: np.ndarray | None = None,
+            piece_counts: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
         """(m,) bool: contacts (a[i], b[i]) proved to carry no point with ``count`` solutions.
 
         ``points`` (m, 2, 3) per end: a point of each connected piece of the end's leaf off g(S) (NaN:
         none known), and ``may`` (m, 2) bool: the pieces that may hold the count.  A piece holds one
         pattern, the one found at its point; without them every pattern of the count is possible.
         ``code_b`` (m,): where not -1, b stands only for its points of that pattern (a pattern node).
+        ``piece_counts`` (m, 2) per end: the certified count of each piece (-1 unknown, -2 no piece); a
+        piece with no point takes the pattern found at a probe point of its leaf whose count is its own
+        and not the other piece's (a point of the leaf off g(S) lies in one of the pieces).
         A leaf modelled as halves has no such restriction: the contact is cut when every pair of a
         half of the one end and a half (or the whole) of the other that meet is proved free of the count.
         """
@@ -95,9 +99,11 @@ class Refuter:
         ra, rb = self._row[ia], self._row[ib]
         only = [np.full((a.size, 2), EVERY, dtype=np.int64), np.full((a.size, 2), EVERY, dtype=np.int64)]
         if points is not None:
-            for end, (i, rows, pts, m) in enumerate(zip((ia, ib), (ra, rb), points, may)):
-                whole = np.where(self._halves[i][:, None, None], np.nan, pts)  # a half's model says nothing of pieces
-                only[end] = self._piece_rows(rows, whole, m)
+            counts = piece_counts or (None, None)
+            for end, (leaf, i, rows, pts, m, pc) in enumerate(zip((a, b), (ia, ib), (ra, rb), points, may, counts)):
+                whole = np.flatnonzero(~self._halves[i])  # a half's model says nothing of its leaf's pieces
+                only[end][whole] = self._piece_rows(leaf[whole], rows[whole], pts[whole], m[whole],
+                                                    None if pc is None else pc[whole])
         if code_b is not None:
             node = np.flatnonzero(code_b >= 0)
             row = row_of(self._patterns, rb[node], code_b[node])
@@ -118,7 +124,8 @@ class Refuter:
         held = np.bincount(c, weights=~free, minlength=a.size)
         return (held == 0) & (np.bincount(c, minlength=a.size) > 0)
 
-    def _piece_rows(self, rows: np.ndarray, pts: np.ndarray, may: np.ndarray) -> np.ndarray:
+    def _piece_rows(self, leaf: np.ndarray, rows: np.ndarray, pts: np.ndarray, may: np.ndarray,
+                    counts: np.ndarray | None) -> np.ndarray:
         """(m, 2) the pattern row of each piece that may hold the count (EVERY where not found), NONE elsewhere."""
         out = np.where(may, EVERY, NONE).astype(np.int64)
         for slot in (0, 1):
@@ -127,7 +134,34 @@ class Refuter:
                 code = pattern_at(self._geometry, self._models, self._patterns, rows[at], pts[at, slot])
                 row = row_of(self._patterns, rows[at], code)
                 out[at, slot] = np.where(row >= 0, row, EVERY)
+        if counts is None:
+            return out
+        # pieces still without a pattern, of a known count that the other piece (if any) does not share
+        known = counts >= 0
+        other = counts[:, ::-1]
+        want = may & (out == EVERY) & known & (other != counts) & ((other >= 0) | (other == NONE_PIECE))
+        need = np.flatnonzero(want.any(axis=1))
+        if need.size == 0:
+            return out
+        lo, hi = self._lo[leaf[need]], self._hi[leaf[need]]
+        probe = lo[:, None, :] + PROBES[None, :, :] * (hi - lo)[:, None, :]  # (k, p, 3)
+        p = PROBES.shape[0]
+        r = np.repeat(rows[need], p)
+        code = pattern_at(self._geometry, self._models, self._patterns, r, probe.reshape(-1, 3))
+        row = row_of(self._patterns, r, code).reshape(-1, p)
+        total = np.where(row >= 0, self._patterns.count[np.maximum(row, 0)], -1)
+        for slot in (0, 1):
+            hit = want[need, slot][:, None] & (total == counts[need, slot][:, None])
+            first = np.argmax(hit, axis=1)
+            got = hit.any(axis=1)
+            out[need[got], slot] = row[got, first[got]]
         return out
+
+
+#: Probe points of a leaf, as fractions of its sides: the centre and the corners drawn in by a tenth.
+PROBES = np.array([[0.5, 0.5, 0.5]] + [[0.1 + 0.8 * ((k >> j) & 1) for j in range(3)] for k in range(8)])
+#: A slot of ``piece_counts`` with no piece (as joint_separation.NO_PIECE).
+NONE_PIECE = -2
 
 
 def near_shortest(n: int, src: np.ndarray, dst: np.ndarray, start: np.ndarray, goal: np.ndarray,

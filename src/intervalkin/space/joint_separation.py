@@ -319,7 +319,9 @@ class _Graph:
         leaf_v[node], code_v[node] = self.pat.leaf[k[node]], self.pat.code[k[node]]
         pts_v = np.where(node[:, None, None], np.nan, self.points[leaf_v])
         may_v = np.where(node[:, None], whole, may[leaf_v])
-        return refuter.cut(u, leaf_v, s[0], (self.points[u], pts_v), (may[u], may_v), code_v)
+        counts = self.sig[:, :, 0]
+        return refuter.cut(u, leaf_v, s[0], (self.points[u], pts_v), (may[u], may_v), code_v,
+                           (counts[u], np.where(node[:, None], UNKNOWN, counts[leaf_v])))
 
     def edges(self, s: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
         """The edges (src, dst) of G_sigma for sigma = ``s`` (nodes: the leaves, then n + the pattern nodes;
