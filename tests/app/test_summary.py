@@ -1,0 +1,40 @@
+"""The summary's counts: the separations' basic-region bound is shown beside the certified one, never as it."""
+
+from __future__ import annotations
+
+import copy
+
+from intervalkin.app.summary import add_separation_bound, chain_table
+
+BASE = {
+    "aspects": {"count": 2, "found": 2, "lower": 2, "lower_bound": 2, "upper": 2, "exact": True, "why": "covers"},
+    "basic_regions": {"count": 22, "found": 22, "lower": 12, "lower_bound": 12, "upper": None, "exact": False,
+                      "why": "sum of the cells"},
+    "uniqueness_domains": {"count": 6, "found": 6, "lower": 6, "lower_bound": 6, "upper": None, "exact": False,
+                           "why": "Theorem 2", "minimal": True},
+    "joint_cells": {"cells": [{"count": 2, "volume": 1.0}], "certified_share": 0.99,
+                    "separations": {"basic_regions_at_least": 18}},
+    "undecided_volume": {"W": 1.0, "WA1": 0.5, "WA2": 0.5},
+    "depth": {"workspace": 8, "singular_layer": 9, "joint": 7},
+}
+
+
+def test_a_higher_separation_bound_is_shown_apart_from_the_certified_one():
+    s = copy.deepcopy(BASE)
+    add_separation_bound(s)
+    block = s["basic_regions"]
+    assert block["separations_at_least"] == 18
+    assert block["lower"] == 12 and block["lower_bound"] == 12  # the certified bound is left alone
+    assert "not re-prove" in block["why"]
+    table = chain_table(s)
+    row = next(line for line in table.splitlines() if line.startswith("basic regions"))
+    assert "certified lower bound 12" in row and "at least 18 by separations" in row
+
+
+def test_no_separation_bound_when_it_adds_nothing():
+    for sep in ({"basic_regions_at_least": 12}, None):
+        s = copy.deepcopy(BASE)
+        s["joint_cells"]["separations"] = sep
+        add_separation_bound(s)
+        assert "separations_at_least" not in s["basic_regions"]
+        assert s["basic_regions"]["why"] == "sum of the cells"
