@@ -1,7 +1,7 @@
 """Benchmark of the direct joint-space paving (a script, not a test).
 
     python benchmarks/bench_joint_paving.py [--depths 6 7] [--geometry FILE] [--samples 2000] [--no-fold]
-        [--model-levels 1] [--face-levels 3] [--workers 1] [--windows]
+        [--model-levels 1] [--face-levels 3] [--workers 1] [--windows] [--separations]
 
 Per depth: boxes, wall time, peak memory (resident set of this process; and, sampled
 every 0.2 s, the largest sum over this process and its workers of the memory each holds
@@ -35,6 +35,7 @@ import psutil
 from intervalkin.core.geometry import default_geometry, load_geometry
 from intervalkin.solve.dkp import solve
 from intervalkin.space.joint_paving import DEFAULT_JOINT_DEPTH, joint_domain, pave_joint_space
+from intervalkin.space.joint_separation import separated_cells
 
 
 class _MemoryWatch:
@@ -110,6 +111,8 @@ def main() -> None:
     ap.add_argument("--windows", action="store_true",
                     help="window models for the leaves with no fold model (as analyze and paper do)")
     ap.add_argument("--workers", type=int, default=None, help="processes (default: the library's, two on 2 cores)")
+    ap.add_argument("--separations", action="store_true",
+                    help="the separations of cells of one signature, and the basic regions they prove (with --windows)")
     args = ap.parse_args()
     g = default_geometry() if args.geometry is None else load_geometry(args.geometry)
     print(f"{'depth':>5} {'boxes':>9} {'seconds':>8} {'peak MB':>8} {'all MB':>7} {'certified':>9} {'regions':>7} "
@@ -153,6 +156,15 @@ def main() -> None:
             f"{st['stage']} {st['level']}: {st['undecided_volume']['clear']:.0f}" for st in jp.paving.stats), flush=True)
         print("       cells: " + "; ".join(f"{c.count} ({c.n_wa1}+{c.n_wa2}) vol {c.volume:.2f} at "
                                           f"({', '.join(f'{float(v):.2f}' for v in c.witness)})" for c in jp.cells))
+        if args.separations:
+            t1 = time.perf_counter()
+            sep = separated_cells(jp, g)
+            print("       separations (" + f"{time.perf_counter() - t1:.1f} s): " + "; ".join(
+                f"{sig[0]} solutions " + " | ".join(",".join(map(str, grp)) for grp in groups)
+                for sig, groups in sorted(sep.groups.items()))
+                + f"; at least {sep.components_at_least()} components and {sep.basic_regions_at_least()} basic regions; "
+                f"{sep.pattern_nodes} pattern nodes, {sep.refuted_contacts} refuted contacts, "
+                f"{sep.leaves_modelled} leaves modelled", flush=True)
         if first is None:
             first = jp
         else:
