@@ -250,7 +250,7 @@ class _Graph:
         self.counts = possible_counts(jp)
         self.has_model = (sig[:, :, 0] != NO_PIECE).any(axis=1)
         self.cells = cells = piece_cells(jp)[0]
-        self.cell_sig = np.full((max(c.id for c in self.every) + 1, 3), -9, dtype=np.int64)
+        self.cell_sig = np.full((max((c.id for c in self.every), default=-1) + 1, 3), -9, dtype=np.int64)
         for c in self.every:
             self.cell_sig[c.id] = c.signature
         # a point of each connected piece of a leaf with a complete model: a clear leaf's centre, a fold piece's witness
