@@ -75,7 +75,7 @@ class _Units:
         self.m = models
         self.wlo, self.whi = _window_arcs(models)
         self.wunit = patterns.rank[patterns.super_of]
-        self.width = int(patterns.rank.max()) + 1
+        self.width = patterns.width
 
     def windows(self, box: int) -> range:
         m = self.m
@@ -408,3 +408,27 @@ def test_the_pattern_test_separates_the_two_cells_of_two_solutions(fold_paving, 
     assert _replace_compatible(monkeypatch, lambda m, p, ra, rb, ov: np.zeros(len(ra), dtype=bool)) >= 1
     with pytest.raises(AssertionError, match="soundness bug"):
         js.separated_cells(fold_paving, paper_geometry)
+
+
+def _synthetic_models(n_windows: int):
+    """One modelled box with n pair windows (end signs equal, D signed: 0 or 2 roots each), no fixed root."""
+    from intervalkin.solve.window_model import WindowModels
+
+    edges = np.linspace(-3.0, 3.0, 2 * n_windows + 1)
+    z = np.zeros(n_windows, dtype=np.int64)
+    return WindowModels(np.array([[[20.0, 20.1]] * 3]), np.array([True]), np.zeros((1, 3), dtype=np.int64),
+                        z, np.full(n_windows, 2, dtype=np.int8), np.ones((n_windows, 2), dtype=np.int8),
+                        np.ones(n_windows, dtype=np.int8), np.arange(n_windows), edges[0:-1:2], edges[1::2],
+                        np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0))
+
+
+def test_patterns_stay_few_and_codes_exact():
+    # 5 pair windows: 2**5 patterns, each digit 0 or 2, codes distinct; 7 windows: more than MAX_PATTERNS, none
+    # (the box stays one node: a neighbour pair of such boxes once filled 24 GB with pairs of patterns)
+    few = jpat.window_patterns(_synthetic_models(5))
+    assert len(few.code) == 32 and len(set(few.code.tolist())) == 32
+    d = jpat.digits(few, few.code)
+    assert d.shape == (32, 5) and set(np.unique(d).tolist()) == {0, 2}
+    assert np.array_equal(few.count, d.sum(axis=1))
+    many = jpat.window_patterns(_synthetic_models(7))
+    assert 2 ** 7 > jpat.MAX_PATTERNS and len(many.code) == 0

@@ -49,6 +49,10 @@ __all__ = ["WindowPatterns", "window_patterns", "pattern_at", "digits", "unit_ov
 
 #: Base of the pattern codes (one digit per super-window).
 BASE = 8
+#: Boxes that may hold more patterns than this get none (they stay one node of the separation graph).
+MAX_PATTERNS = 64
+#: Super-windows of a box with patterns, at most (8**20 < 2**63: a code is an exact int64).
+MAX_DIGITS = 20
 
 
 @dataclass(frozen=True, eq=False)
@@ -57,7 +61,8 @@ class WindowPatterns:
 
     super_of : (w,) the super-window of each window; rank : (s,) the rank of each super-window in
     its box; box : (k,) the box of each pattern row; code : (k,) its code; count : (k,) its total
-    count (roots off the windows plus the pattern's).
+    count (roots off the windows plus the pattern's); width : the super-windows of the boxes with rows
+    (at most :data:`MAX_DIGITS`), the number of digits of a code.
     """
 
     super_of: np.ndarray
@@ -65,6 +70,7 @@ class WindowPatterns:
     box: np.ndarray
     code: np.ndarray
     count: np.ndarray
+    width: int = 1
 
 
 def _window_sets(models: WindowModels) -> np.ndarray:
@@ -114,7 +120,8 @@ def _super_windows(models: WindowModels) -> np.ndarray:
 def window_patterns(models: WindowModels) -> WindowPatterns:
     """Every pattern each modelled box may hold (the product of its super-windows' possible counts).
 
-    Boxes not modelled, or with a super-window that might hold more than 7 roots, get no rows.
+    Boxes not modelled, with a super-window that might hold more than 7 roots, or with more than
+    :data:`MAX_PATTERNS` patterns, get no rows.
     """
     sup = _super_windows(models)
     nsup = int(sup.max()) + 1 if sup.size else 0
@@ -139,9 +146,18 @@ def window_patterns(models: WindowModels) -> WindowPatterns:
     wide = np.zeros(len(models.ok), dtype=bool)  # a super-window that might hold 8 roots or more: no digit for it
     wide[models.window_box[(ssets[sup] >> BASE) != 0]] = True
     ssets &= (1 << BASE) - 1
-    ok = np.flatnonzero(models.ok & ~wide)
+    # the number of patterns is the product of the super-windows' choices: past MAX_PATTERNS a box stays one
+    # node (its count mask), or the pairs of patterns of two such neighbours would fill the memory
+    choices = sum((ssets >> k) & 1 for k in range(BASE))
+    log_rows = np.zeros(len(models.ok))
+    np.add.at(log_rows, sbox, np.log2(np.maximum(choices, 1)))
+    crowded = log_rows > np.log2(MAX_PATTERNS) + 1e-9
+    crowded[sbox[rank >= MAX_DIGITS]] = True  # a code holds MAX_DIGITS digits in an int64
+    ok = np.flatnonzero(models.ok & ~wide & ~crowded)
+    kept = np.isin(sbox, ok)
+    width = int(rank[kept].max()) + 1 if kept.any() else 1
     box, code, count = ok.copy(), np.zeros(ok.size, dtype=np.int64), models.off[ok, 0].astype(np.int64)
-    for r in range(int(rank.max()) + 1 if nsup else 0):
+    for r in range(width):
         at = np.flatnonzero(rank == r)
         mask_of = np.zeros(len(models.ok), dtype=np.int64)
         has = np.zeros(len(models.ok), dtype=bool)
@@ -154,7 +170,7 @@ def window_patterns(models: WindowModels) -> WindowPatterns:
             rows_n.append(count[take] + c)
         box, code, count = np.concatenate(rows_b), np.concatenate(rows_c), np.concatenate(rows_n)
     order = np.lexsort((code, box))
-    return WindowPatterns(sup, rank, box[order], code[order], count[order])
+    return WindowPatterns(sup, rank, box[order], code[order], count[order], width)
 
 
 def pattern_at(geometry: Geometry, models: WindowModels, patterns: WindowPatterns, rows: np.ndarray,
@@ -165,17 +181,21 @@ def pattern_at(geometry: Geometry, models: WindowModels, patterns: WindowPattern
     if len(rows) == 0:
         return out
     counts = window_root_counts(geometry, models, rows, points)
-    digit = counts.roots[:, 0] * BASE ** patterns.rank[patterns.super_of[counts.win]]
-    code = np.bincount(counts.pt, weights=digit, minlength=counts.live.size).astype(np.int64)
-    good = counts.decided()
+    rank = patterns.rank[patterns.super_of[counts.win]]
+    digit = counts.roots[:, 0].astype(np.int64) * BASE ** np.minimum(rank, MAX_DIGITS - 1)
+    code = np.zeros(counts.live.size, dtype=np.int64)
+    np.add.at(code, counts.pt, digit)  # in integers: a float sum would round codes past 2**53
+    # a box with no patterns (one with a digit past MAX_DIGITS among them) has no code either
+    held = np.zeros(len(models.ok), dtype=bool)
+    held[patterns.box] = True
+    good = counts.decided() & held[rows[counts.live]]
     out[counts.live[good]] = code[good]
     return out
 
 
 def digits(patterns: WindowPatterns, code: np.ndarray) -> np.ndarray:
     """(m, K) int64: the count in each super-window (by rank) of the pattern codes ``code``."""
-    width = int(patterns.rank.max()) + 1 if patterns.rank.size else 1
-    return (np.asarray(code, dtype=np.int64)[:, None] // BASE ** np.arange(width)) % BASE
+    return (np.asarray(code, dtype=np.int64)[:, None] // BASE ** np.arange(patterns.width)) % BASE
 
 
 def _arcs(start: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -190,8 +210,8 @@ def _arcs(start: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _units(models: WindowModels, patterns: WindowPatterns) -> tuple[np.ndarray, ...]:
     """The arcs that hold roots, sorted by box: windows (unit: their super-window's rank) and fixed-root
     arcs (unit: K + their position in the box).  Returns box, unit, lo (k, 2), hi (k, 2), and (n,) the number
-    of fixed-root arcs of each box."""
-    width = int(patterns.rank.max()) + 1 if patterns.rank.size else 1
+    of fixed-root arcs of each box.  Only the boxes with patterns: the others' ranks may pass the width."""
+    width = patterns.width
     w = len(models.degree)
     pw = models.piece_window
     first = np.searchsorted(pw, np.arange(w), side="left")
@@ -202,7 +222,10 @@ def _units(models: WindowModels, patterns: WindowPatterns) -> tuple[np.ndarray, 
     rlo, rhi = _arcs(models.root_lo, models.root_hi)
     box = np.r_[models.window_box, rb]
     unit = np.r_[patterns.rank[patterns.super_of], width + pos]
-    order = np.argsort(box, kind="stable")
+    held = np.zeros(len(models.ok), dtype=bool)
+    held[patterns.box] = True
+    order = np.flatnonzero(held[box])
+    order = order[np.argsort(box[order], kind="stable")]
     lo, hi = np.r_[wlo, rlo][order], np.r_[whi, rhi][order]
     return box[order], unit[order], lo, hi, np.bincount(rb, minlength=len(models.ok))
 
@@ -217,8 +240,7 @@ def unit_overlaps(models: WindowModels, patterns: WindowPatterns, box_a: np.ndar
     """
     box_a, box_b = np.asarray(box_a, dtype=np.int64), np.asarray(box_b, dtype=np.int64)
     box, unit, lo, hi, n_roots = _units(models, patterns)
-    width = int(patterns.rank.max()) + 1 if patterns.rank.size else 1
-    size = max(int(unit.max()) + 1 if unit.size else 1, width)  # every super-window digit has a unit
+    size = max(int(unit.max()) + 1 if unit.size else 1, patterns.width)  # every super-window digit has a unit
     out = np.zeros((box_a.size, size, size), dtype=bool)
     if box_a.size == 0 or box.size == 0:
         return out
