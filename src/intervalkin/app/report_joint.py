@@ -53,8 +53,8 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
     out.append(f"\nSum: {terms} = {sum(counts)} basic regions found"
                + (f" (proved lower bound {lower}" if lower is not None else " (")
                + (f", upper bound {br['upper']})" if br.get("upper") is not None else "; no upper bound is proved)")
-               + ". Cells with equal counts are not yet proved to be different components of the joint box "
-               "minus g(S), and undecided boxes could still join two of them or hide a small one.\n")
+               + ". Cells with equal counts are proved to be different components of the joint box minus g(S) "
+               "only where the separations below say so, and undecided boxes could still hide a small one.\n")
     closed = (jc.get("closed_cells") or {}).get("closed") or []
     if closed:
         sig = {c["id"]: c["count"] for c in jc["cells"] + (jc.get("fragments") or [])}
