@@ -6,7 +6,13 @@ sigma, the join runs through some contacts between leaves with complete models (
 traces are not decided, pieces of unknown count).  Those leaves get window models here, on demand, and
 a contact is cut for sigma when no pattern of the one end with sigma's count can meet a pattern of the
 other with that count on the face (:func:`intervalkin.space.joint_patterns.exclusive`, proofs/
-lemma-window-patterns.md): a point of the face with that count would hold one in each.
+lemma-refuted-contact.md): a point of the face with that count would hold one in each.  A piece of a
+complete model is connected and off g(S), so it holds one pattern: the one found at its witness, or
+at a probe point of the leaf whose count is the piece's and not the other piece's.  A leaf whose own
+window model fails is modelled by its eight halves (which tile it), with no restriction.
+
+What is certified: every cut (the lemma; every sign behind it in ball arithmetic).  What is not:
+nothing is written to the certificates, so ``intervalkin verify`` does not re-prove the cuts.
 
 Which contacts are tried is a choice of effort, not of soundness: those on the shortest chains of
 G_sigma between the cells of a group (breadth first from one cell and from the others; a contact
@@ -24,7 +30,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.solve.window_model import WindowModels, window_models
 from intervalkin.space.joint_patterns import EVERY, NONE, exclusive, pattern_at, row_of, window_patterns
 
-__all__ = ["Refuter", "SLACK", "BATCH"]
+__all__ = ["Refuter", "near_shortest", "SLACK", "BATCH"]
 
 #: Chains tried: up to this many contacts longer than the shortest.
 SLACK = 2
