@@ -342,12 +342,10 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     dw, ds, dj = chain_depths(depth)
     stages = _Stages(progress)
     joint = _joint_space(geometry, ds, dj, stages)
-    full = dj - 1 >= DEFAULT_JOINT_DEPTH  # below the default depth, a preview: one level of local refinement
-    # window models (with their patterns, what separates cells of one count) only at full depth: +30 s
+    full = dj - 1 >= DEFAULT_JOINT_DEPTH  # below it a preview: one local level, no window models (separations need them)
     levels = {"model_levels": MODEL_LEVELS if full else 1, "face_levels": FACE_LEVELS if full else 0, "windows": full}
     name = (f"joint space paved directly (depth {dj - 1}, local models{', window models' if full else ''}, "
-            f"{levels['model_levels']} + "
-            f"{levels['face_levels']} levels of local and face refinement, {JOIN_LEVELS} join levels)")
+            f"{levels['model_levels']} + {levels['face_levels']} levels of local and face refinement, {JOIN_LEVELS} join levels)")
     with contextlib.ExitStack() as side:
         future = None
         daemonic = multiprocessing.current_process().daemon

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.space.joint_patterns import compatible, pattern_at, unit_overlaps, window_patterns
+from intervalkin.space.joint_patterns import compatible, pattern_at, row_of, unit_overlaps, window_patterns
 
 __all__ = ["PatternNodes", "expand", "runs"]
 
@@ -103,24 +103,14 @@ class PatternNodes:
         return out
 
     def row_of(self, leaf: np.ndarray, code: np.ndarray) -> np.ndarray:
-        """Row of (leaf, code), -1 where code is -1 or not a row (a leaf's rows are sorted by code)."""
+        """Node of (leaf, code), -1 where code is -1 or not a pattern node of the leaf."""
         out = np.full(leaf.size, -1, dtype=np.int64)
         if self.leaf.size == 0 or leaf.size == 0:
             return out
-        lo, size = runs(self.leaf, leaf)
-        hi = lo + size
-        while True:  # binary search in each leaf's run, all leaves at once
-            live = lo < hi
-            if not live.any():
-                break
-            mid = (lo + hi) // 2
-            below = live & (self.code[np.minimum(mid, self.code.size - 1)] < code)
-            lo = np.where(below, mid + 1, lo)
-            hi = np.where(live & ~below, mid, hi)
-        end = runs(self.leaf, leaf)[0] + size
-        found = (lo < end) & (code >= 0)
-        found[found] = self.code[lo[found]] == code[found]
-        out[found] = lo[found]
+        row = row_of(self._wp, np.searchsorted(self._w.leaf, leaf), code)  # a row of all the window patterns
+        node = np.minimum(np.searchsorted(self._row, row), self._row.size - 1)  # self._row is sorted
+        found = (row >= 0) & (self._row[node] == row)
+        out[found] = node[found]
         return out
 
     def at(self, geometry: Geometry, leaf: np.ndarray, points: np.ndarray) -> np.ndarray:
