@@ -298,3 +298,26 @@ def test_claimed_inner_cut_signs_are_caught(paper_geometry, models):
         assert changed.size >= 10
         truth = _truth(paper_geometry, points[changed])
         assert np.all(np.any(sig[changed] != truth, axis=1))
+
+
+def test_take_is_the_model_of_those_boxes_alone(paper_geometry, no_model_leaves, models):
+    # each box is modelled on its own, so the rows taken from the models of many boxes must be, array for
+    # array, the models of those boxes computed alone (a window, piece or root arc moved to another box fails)
+    rows = np.flatnonzero(models.ok)[1::7][:40]
+    rows = np.sort(np.concatenate([rows, np.flatnonzero(~models.ok)[:3]]))
+    taken, alone = models.take(rows), window_models(paper_geometry, no_model_leaves[rows])
+    for name in taken.__dataclass_fields__:
+        assert np.array_equal(getattr(taken, name), getattr(alone, name)), name
+    assert len(taken.degree) > len(rows) and len(taken.root_box) > 0
+
+
+def test_points_only_in_boxes_without_windows_are_counted(paper_geometry, models):
+    # a call whose boxes have no window at all (once an IndexError): the count is the roots off the windows
+    _, n = models.windows_of(np.arange(len(models.ok)))
+    rows = np.flatnonzero(models.ok & (n == 0))[:3]
+    assert rows.size
+    points = models.boxes[rows].mean(axis=2)
+    sig = window_signature(paper_geometry, models, rows, points)
+    assert np.array_equal(sig, models.off[rows])
+    truth = np.array([split_of(solve(paper_geometry, [Fraction(float(v)) for v in p])) for p in points])
+    assert np.array_equal(sig, truth)

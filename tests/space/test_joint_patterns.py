@@ -423,12 +423,16 @@ def _synthetic_models(n_windows: int):
 
 
 def test_patterns_stay_few_and_codes_exact():
-    # 5 pair windows: 2**5 patterns, each digit 0 or 2, codes distinct; 7 windows: more than MAX_PATTERNS, none
-    # (the box stays one node: a neighbour pair of such boxes once filled 24 GB with pairs of patterns)
+    # 5 pair windows (digits 0 or 2): 2**5 combinations, of which those with at most MAX_ROOTS = 6 roots
+    # (at most three pairs) are patterns, codes distinct; 7 windows: 64 left, kept; 8: 93 left, more than
+    # MAX_PATTERNS, none (the box stays one node: a neighbour pair of such boxes once filled 24 GB with pairs
+    # of patterns); 15: past MAX_ENUMERATED, not enumerated
     few = jpat.window_patterns(_synthetic_models(5))
-    assert len(few.code) == 32 and len(set(few.code.tolist())) == 32
+    assert len(few.code) == 1 + 5 + 10 + 10 and len(set(few.code.tolist())) == 26
     d = jpat.digits(few, few.code)
-    assert d.shape == (32, 5) and set(np.unique(d).tolist()) == {0, 2}
-    assert np.array_equal(few.count, d.sum(axis=1))
-    many = jpat.window_patterns(_synthetic_models(7))
-    assert 2 ** 7 > jpat.MAX_PATTERNS and len(many.code) == 0
+    assert d.shape == (26, 5) and set(np.unique(d).tolist()) == {0, 2}
+    assert np.array_equal(few.count, d.sum(axis=1)) and few.count.max() == jpat.MAX_ROOTS
+    assert len(jpat.window_patterns(_synthetic_models(7)).code) == 64 == jpat.MAX_PATTERNS
+    for n in (8, 15):
+        assert len(jpat.window_patterns(_synthetic_models(n)).code) == 0
+    assert 2 ** 15 > jpat.MAX_ENUMERATED

@@ -97,8 +97,9 @@ def test_a_refuter_that_trusts_the_wrong_patterns_is_caught(graph, fold_paving, 
 def test_halves_stand_for_leaves_whose_model_fails(graph, fold_paving, paper_geometry):
     rng = np.random.default_rng(33)
     refuter = Refuter(paper_geometry, fold_paving.paving.lo, fold_paving.paving.hi)
-    # leaves with no model at all: the ones most likely to need halves
-    bare = np.flatnonzero(~graph.has_model & (graph.counts == js.ANY) & (fold_paving.cell < 0))
+    # leaves with neither a complete model nor pattern nodes (no window model, or too many patterns): the
+    # ones most likely to need halves
+    bare = np.flatnonzero(~graph.has_model & ~graph.pat.is_p & (fold_paving.cell < 0))
     ends = np.isin(graph.a, bare) | np.isin(graph.b, bare)
     pick = rng.choice(np.flatnonzero(ends), min(int(ends.sum()), 400), replace=False)
     a, b = graph.a[pick], graph.b[pick]

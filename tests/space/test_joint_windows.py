@@ -120,3 +120,25 @@ def test_npz_columns_of_window_pieces(fold_paving, paper_geometry):
     assert np.array_equal(near[1][crossed], cols["count_above"][leaf][crossed])
     same = (near[0] >= 0) & (near[0] == near[1])
     assert np.all((near[0][same] == cols["count_below"][leaf][same]) | (near[0][same] == cols["count_above"][leaf][same]))
+
+
+def test_leaves_whose_model_fails_are_split_and_their_children_modelled(fold_paving, paper_geometry):
+    """window_refinement: a leaf whose window model fails is replaced by its eight children (up to
+    WINDOW_LEVELS times), so a failed model is left only on leaves that many levels finer than the paving's
+    other leaves; the leaves stay a partition of the joint box, and the children's models are their own."""
+    from intervalkin.solve.window_model import window_models
+    from intervalkin.space.joint_windows import WINDOW_LEVELS
+
+    w, p = fold_paving.windows, fold_paving.paving
+    st = fold_paving.fold_stats["windows"]
+    assert st["leaves_split"] > 0
+    assert np.isclose(p.volume().sum(), np.prod(np.diff(p.domain, axis=1)))
+    failed = w.leaf[~w.models.ok]
+    split_levels = np.unique(p.level[failed])
+    assert failed.size == 0 or split_levels.min() >= int(p.level[w.leaf[w.models.ok]].min()) + 1
+    rows = np.flatnonzero(w.models.ok)[-12:]  # the last rows: children of split leaves
+    boxes = np.stack([p.lo[w.leaf[rows]], p.hi[w.leaf[rows]]], axis=-1)
+    assert np.array_equal(w.models.boxes[rows], boxes)
+    again = window_models(paper_geometry, boxes)
+    assert np.array_equal(again.degree, w.models.take(rows).degree)
+    assert WINDOW_LEVELS >= 1

@@ -67,6 +67,8 @@ def window_root_counts(geometry: Geometry, models: WindowModels, rows: np.ndarra
     wstart, wcount = models.windows_of(rows[live])
     pt = np.repeat(np.arange(live.size), wcount)  # pairs (point, window)
     win = np.repeat(wstart - (np.cumsum(wcount) - wcount), wcount) + np.arange(pt.size)
+    if pt.size == 0:  # no windows at these points: every count is the roots off the windows (np.r_ below needs one)
+        return WindowCounts(live, pt, win, np.full((0, 2), -1, dtype=np.int64))
     pstart = np.searchsorted(models.piece_window, win, side="left")
     pcount = np.searchsorted(models.piece_window, win, side="right") - pstart
     pair = np.repeat(np.arange(pt.size), pcount)  # sub-pieces, first the window's pieces

@@ -117,6 +117,21 @@ class WindowModels:
             (self.piece_hi, other.piece_hi), (self.root_box, other.root_box + n), (self.root_lo, other.root_lo),
             (self.root_hi, other.root_hi))))
 
+    def take(self, rows: np.ndarray) -> "WindowModels":
+        """The models of boxes ``rows`` (increasing), with their windows, pieces and root arcs, renumbered."""
+        rows = np.asarray(rows, dtype=np.int64)
+        new = np.full(len(self.ok), -1, dtype=np.int64)
+        new[rows] = np.arange(rows.size)
+        win = np.flatnonzero(new[self.window_box] >= 0)
+        renumber = np.full(len(self.degree), -1, dtype=np.int64)
+        renumber[win] = np.arange(win.size)
+        piece = np.flatnonzero(renumber[self.piece_window] >= 0)
+        root = np.flatnonzero(new[self.root_box] >= 0)
+        return WindowModels(self.boxes[rows], self.ok[rows], self.off[rows], new[self.window_box[win]],
+                            self.degree[win], self.end_signs[win], self.d_sign[win],
+                            renumber[self.piece_window[piece]], self.piece_lo[piece], self.piece_hi[piece],
+                            new[self.root_box[root]], self.root_lo[root], self.root_hi[root])
+
     def box_wide(self) -> np.ndarray:
         """(w,) bool: windows whose end signs and sign of D hold over the whole box (non-zero)."""
         return (self.d_sign != 0) & np.all(self.end_signs != 0, axis=1)

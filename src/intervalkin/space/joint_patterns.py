@@ -51,6 +51,11 @@ __all__ = ["WindowPatterns", "window_patterns", "pattern_at", "digits", "unit_ov
 BASE = 8
 #: Boxes that may hold more patterns than this get none (they stay one node of the separation graph).
 MAX_PATTERNS = 64
+#: Roots of f(phi; r) on the circle at most: a trigonometric polynomial of degree 3 that is not identically
+#: zero (a window model proves a derivative or the value nonzero at every point of its box) has at most 6.
+MAX_ROOTS = 6
+#: Boxes whose super-windows' choices multiply past this are not enumerated (the rows before pruning).
+MAX_ENUMERATED = 1 << 14
 #: Super-windows of a box with patterns, at most (8**20 < 2**63: a code is an exact int64).
 MAX_DIGITS = 20
 
@@ -118,10 +123,11 @@ def _super_windows(models: WindowModels) -> np.ndarray:
 
 
 def window_patterns(models: WindowModels) -> WindowPatterns:
-    """Every pattern each modelled box may hold (the product of its super-windows' possible counts).
+    """Every pattern each modelled box may hold: the product of its super-windows' possible counts, less
+    the combinations with more than :data:`MAX_ROOTS` roots in all (no point of the box has them).
 
-    Boxes not modelled, with a super-window that might hold more than 7 roots, or with more than
-    :data:`MAX_PATTERNS` patterns, get no rows.
+    Boxes not modelled, with a super-window that might hold more than 7 roots, with more than
+    :data:`MAX_ENUMERATED` combinations, or with more than :data:`MAX_PATTERNS` patterns left, get no rows.
     """
     sup = _super_windows(models)
     nsup = int(sup.max()) + 1 if sup.size else 0
@@ -146,12 +152,12 @@ def window_patterns(models: WindowModels) -> WindowPatterns:
     wide = np.zeros(len(models.ok), dtype=bool)  # a super-window that might hold 8 roots or more: no digit for it
     wide[models.window_box[(ssets[sup] >> BASE) != 0]] = True
     ssets &= (1 << BASE) - 1
-    # the number of patterns is the product of the super-windows' choices: past MAX_PATTERNS a box stays one
-    # node (its count mask), or the pairs of patterns of two such neighbours would fill the memory
+    # the combinations are the product of the super-windows' choices; the rows kept after pruning are
+    # bounded below, since pairs of the patterns of two crowded neighbours would fill the memory
     choices = sum((ssets >> k) & 1 for k in range(BASE))
     log_rows = np.zeros(len(models.ok))
     np.add.at(log_rows, sbox, np.log2(np.maximum(choices, 1)))
-    crowded = log_rows > np.log2(MAX_PATTERNS) + 1e-9
+    crowded = log_rows > np.log2(MAX_ENUMERATED) + 1e-9
     crowded[sbox[rank >= MAX_DIGITS]] = True  # a code holds MAX_DIGITS digits in an int64
     ok = np.flatnonzero(models.ok & ~wide & ~crowded)
     kept = np.isin(sbox, ok)
@@ -169,6 +175,10 @@ def window_patterns(models: WindowModels) -> WindowPatterns:
             rows_c.append(code[take] + c * BASE ** r)
             rows_n.append(count[take] + c)
         box, code, count = np.concatenate(rows_b), np.concatenate(rows_c), np.concatenate(rows_n)
+        possible = count <= MAX_ROOTS  # digits only add roots: a row past the bound stays past it
+        box, code, count = box[possible], code[possible], count[possible]
+    many = np.bincount(box, minlength=len(models.ok)) > MAX_PATTERNS
+    box, code, count = box[~many[box]], code[~many[box]], count[~many[box]]
     order = np.lexsort((code, box))
     return WindowPatterns(sup, rank, box[order], code[order], count[order], width)
 

@@ -66,7 +66,7 @@ from intervalkin.space.joint_pieces import FoldPieces, PieceSignatures, piece_si
 from intervalkin.space.joint_places import WHY_OPEN, open_places
 from intervalkin.space.joint_window_pieces import (check_window_cells, signatures_from_windows, window_cell_of,
                                                    window_columns, window_pieces)
-from intervalkin.space.joint_windows import JointWindows, joint_windows
+from intervalkin.space.joint_windows import JointWindows, window_refinement
 
 __all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain", "DEFAULT_JOINT_DEPTH", "JOIN_LEVELS", "MODEL_LEVELS"]
 
@@ -356,7 +356,8 @@ def _pave(geometry: Geometry, depth: int, join_levels: int, progress, fold: bool
         paving = leaves_to_paving(domain, leaves, stats)
         wins = None
         if windows:
-            found_windows = joint_windows(geometry, paving.lo, paving.hi, ~leaves[4] & (store.rows(leaves) < 0), pool)
+            leaves, paving, found_windows, fine = window_refinement(geometry, domain, leaves, stats, store, progress,
+                                                                     fine, pool)
             if progress is not None:
                 progress({"stage": "window models", "level": fine, "depth": fine, "boxes": len(found_windows.leaf),
                           "split": 0, "cells": 0})

@@ -55,7 +55,7 @@ NO_PIECE, UNKNOWN = -2, -1
 #: Possible-count mask of a leaf that may hold any count.
 ANY = -1
 #: Rounds of window models on the shortest chains joining two cells of one signature (joint_refutation).
-REFUTE_ROUNDS = 6
+REFUTE_ROUNDS = 16
 
 
 @dataclass(frozen=True)

@@ -25,8 +25,12 @@ from intervalkin.core.workers import Workers
 from intervalkin.solve.window_fold import CLEAR, FOLD, WindowFolds, window_folds
 from intervalkin.solve.window_count import window_signature
 from intervalkin.solve.window_model import WindowModels, window_models
+from intervalkin.space.joint_leaves import leaves_to_paving, refine_leaves, timed_step
 
-__all__ = ["JointWindows", "joint_windows"]
+__all__ = ["JointWindows", "joint_windows", "window_refinement", "WINDOW_LEVELS"]
+
+#: Times a leaf whose window model fails is split and its children modelled again.
+WINDOW_LEVELS = 2
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,12 +44,36 @@ class JointWindows:
     seconds : the time spent building them.
     folds : which models prove the leaf off g(S) (window-clear) or cut by one monotone sheet
         into two connected pieces (window folds; :mod:`intervalkin.solve.window_fold`).
+    split : leaves whose model failed and that were split, their children modelled in their place
+        (:func:`window_refinement`).
     """
 
     leaf: np.ndarray
     models: WindowModels
     seconds: float
     folds: WindowFolds | None = None
+    split: int = 0
+
+    def without(self, drop: np.ndarray, renumber: np.ndarray) -> "JointWindows":
+        """These rows less those marked ``drop`` (k,), their leaves renumbered by ``renumber`` (old -> new)."""
+        rows = np.flatnonzero(~drop)
+        folds = self.folds
+        if folds is not None:
+            kept = np.zeros(len(self.models.degree), dtype=np.int64)
+            kept[np.isin(self.models.window_box, rows)] = 1
+            window = np.cumsum(kept) - 1  # windows keep their order: the new index of each kept one
+            w = folds.window[rows]
+            folds = WindowFolds(folds.kind[rows], np.where(w >= 0, window[np.maximum(w, 0)], -1), folds.rising[rows],
+                                folds.signature[rows], folds.edge_rising[rows])
+        return JointWindows(renumber[self.leaf[rows]], self.models.take(rows), self.seconds, folds, self.split)
+
+    def concat(self, other: "JointWindows") -> "JointWindows":
+        """These rows followed by ``other``'s (whose leaves must all come after these)."""
+        folds = None
+        if self.folds is not None and other.folds is not None:
+            folds = self.folds.concat(other.folds, len(self.models.degree))
+        return JointWindows(np.concatenate([self.leaf, other.leaf]), self.models.concat(other.models),
+                            self.seconds + other.seconds, folds, self.split + other.split)
 
     def pieced_mask(self, n: int) -> np.ndarray:
         """(n,) bool over the paving's leaves: the window-clear leaves and the window folds."""
@@ -80,6 +108,7 @@ class JointWindows:
                 "volume_tried": float(volume[self.leaf].sum()), "volume_modelled": float(volume[self.leaf[ok]].sum()),
                 "pair_windows": int(np.count_nonzero(self.models.degree == 2)),
                 "triple_windows": int(np.count_nonzero(self.models.degree == 3)), "seconds": self.seconds,
+                "leaves_split": self.split,
                 **({} if self.folds is None else {
                     "window_clear": int(np.count_nonzero(self.folds.kind == CLEAR)),
                     "window_folds": int(np.count_nonzero(self.folds.kind == FOLD)),
@@ -100,6 +129,35 @@ def joint_windows(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, no_model: 
         folds = folds.concat(f, len(models.degree))
         models = models.concat(m)
     return JointWindows(leaf, models, time.perf_counter() - t0, folds)
+
+
+def window_refinement(geometry: Geometry, domain: np.ndarray, leaves, stats: list, store, progress, fine: int,
+                      workers: Workers, levels: int = WINDOW_LEVELS):
+    """Window models of the undecided leaves without a fold model, a leaf whose model fails split in eight
+    (up to ``levels`` times): its children are tested, given local models and window models in its place.
+
+    Near a cusp edge meeting another sheet of g(S) one leaf may hold more roots in play than a window
+    bounds; its halves are smaller and are modelled.  Returns (leaves, paving, windows, finest level).
+    """
+    paving = leaves_to_paving(domain, leaves, stats)
+    found = joint_windows(geometry, paving.lo, paving.hi, store.unresolved(leaves), workers)
+    for _ in range(levels):
+        failed = np.zeros(len(paving), dtype=bool)
+        failed[found.leaf[~found.models.ok]] = True
+        if not failed.any():
+            break
+        # refine_leaves keeps the other leaves in their order and appends the children
+        renumber, kept = np.cumsum(~failed) - 1, int(np.count_nonzero(~failed))
+        leaves = timed_step(progress, stats, store, "window refinement", fine + 1,
+                            lambda: store.settle(refine_leaves(geometry, domain, leaves, failed, workers)), leaves, failed)
+        fine = max(fine, int(leaves[0].max()))
+        paving = leaves_to_paving(domain, leaves, stats)
+        children = np.zeros(len(paving), dtype=bool)
+        children[kept:] = True
+        more = joint_windows(geometry, paving.lo, paving.hi, children & store.unresolved(leaves), workers)
+        found = found.without(failed[found.leaf], renumber).concat(more)
+        found = JointWindows(found.leaf, found.models, found.seconds, found.folds, found.split + int(failed.sum()))
+    return leaves, paving, found, fine
 
 
 def _modelled(geometry: Geometry, boxes: np.ndarray) -> tuple[WindowModels, WindowFolds]:
