@@ -38,3 +38,14 @@ def test_no_separation_bound_when_it_adds_nothing():
         add_separation_bound(s)
         assert "separations_at_least" not in s["basic_regions"]
         assert s["basic_regions"]["why"] == "sum of the cells"
+
+
+def test_a_separation_bound_that_meets_the_count_says_so_and_stays_a_lower_bound():
+    s = copy.deepcopy(BASE)
+    s["joint_cells"]["separations"] = {"basic_regions_at_least": 22}
+    add_separation_bound(s)
+    block = s["basic_regions"]
+    assert block["separations_at_least"] == 22 and not block["exact"] and block["upper"] is None
+    row = next(line for line in chain_table(s).splitlines() if line.startswith("basic regions"))
+    assert "at least 22 by separations" in row and "the count found: no upper bound yet" in row
+    assert not row.rstrip().endswith("exact")

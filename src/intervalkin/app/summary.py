@@ -216,8 +216,9 @@ def chain_table(summary: dict) -> str:
     def status(block):
         if block.get("exact"):
             return "exact"
-        more = (f"; at least {block['separations_at_least']} by separations (not re-proved by verify)"
-                if "separations_at_least" in block else "")
+        n = block.get("separations_at_least")
+        more = "" if n is None else (f"; at least {n} by separations (not re-proved by verify)"
+                                     + (", the count found: no upper bound yet" if n >= block["count"] else ""))
         return f"found; certified lower bound {block['lower_bound']}{more}"
 
     rows = [

@@ -139,14 +139,14 @@ class CellSolver:
         wp = windows_of(self.edges, pieces) if windows_of is not None else None
         self.window_pieces = wp
         w2 = len(wp.witness) if wp is not None else 0
-        witness = np.concatenate([pieces.witness if m2 else np.zeros((0, 3)), wp.witness if w2 else np.zeros((0, 3))])
+        piece_points = np.concatenate([pieces.witness if m2 else np.zeros((0, 3)), wp.witness if w2 else np.zeros((0, 3))])
         # half a fold box or window fold to each of its pieces: a float measure for ordering and reports
         pv = np.repeat(np.concatenate([paving.volume()[pieces.box] if m2 else np.zeros(0),
                                        paving.volume()[wp.box] if w2 else np.zeros(0)]), 2) / 2.0
         if m2 or w2:
             live = np.zeros(n + m2 + w2, dtype=bool)
             live[:n] = ok
-            live[n:] = np.isfinite(witness).all(axis=1)
+            live[n:] = np.isfinite(piece_points).all(axis=1)
             both = ok[self.edges[0]] & ok[self.edges[1]]
             extra = [x.edges for x in (pieces, wp) if x is not None]
             for x in extra:
@@ -211,7 +211,8 @@ class CellSolver:
                         self._solved[int(keys[b])] = (sig, witness)  # only proved signatures are reused
                         break
                 if sig[0] < 0 and (m2 or w2):
-                    for w in witness[p_order[p_start[c]:p_end[c]]][:4 * _TRIES]:
+                    # no clear box of the cell gave a complete solve (or it has none): try its pieces' points
+                    for w in piece_points[p_order[p_start[c]:p_end[c]]][:4 * _TRIES]:
                         if np.isfinite(w).all():
                             sig, witness = self._signature(w, w)
                             if sig[0] >= 0:

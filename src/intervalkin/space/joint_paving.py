@@ -285,8 +285,8 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     windows : with ``fold``, give the leaves left without a model window models
         (:mod:`intervalkin.space.joint_windows`): certified counts at their points, and proved
         pieces for the window-clear leaves and window folds among them.  On the paper's manipulator
-        at the default depth: 80265 of 107742 such leaves, 74 % of their volume; off by default (the
-        paper run leaves them off to stay within two minutes).
+        at the default depth: all of them once the 13 whose model fails are split (window_refinement);
+        off by default here, on in ``analyze``/``paper`` at full depth.
     workers : processes (default: two on a machine with two cores or more, see
         :func:`intervalkin.core.workers.default_workers`); large steps are cut into parts
         computed at once, and the paving is the same bit for bit whatever the number.
@@ -356,15 +356,16 @@ def _pave(geometry: Geometry, depth: int, join_levels: int, progress, fold: bool
         paving = leaves_to_paving(domain, leaves, stats)
         wins = None
         if windows:
-            leaves, paving, found_windows, fine = window_refinement(geometry, domain, leaves, stats, store, progress,
-                                                                     fine, pool)
+            leaves, paving, found_windows, fine, made = window_refinement(geometry, domain, leaves, stats, store,
+                                                                           progress, fine, pool)
             if progress is not None:
                 progress({"stage": "window models", "level": fine, "depth": fine, "boxes": len(found_windows.leaf),
                           "split": 0, "cells": 0})
 
             def wins(e, fp):
                 return window_pieces(geometry, paving.lo, paving.hi, leaves[4], e, fp, found_windows, pool)
-        labelled = cells.label(paving, fine, lambda e: store.pieces(leaves, e), anchor(leaves), wins)
+        starts = anchor(leaves) & ~made if windows else anchor(leaves)
+        labelled = cells.label(paving, fine, lambda e: store.pieces(leaves, e), starts, wins)
         cell, found, pieces, piece_cell = labelled
         window_cell = cells.window_cell
         unjoined = cells.unjoined

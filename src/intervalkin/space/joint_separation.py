@@ -55,7 +55,7 @@ NO_PIECE, UNKNOWN = -2, -1
 #: Possible-count mask of a leaf that may hold any count.
 ANY = -1
 #: Rounds of window models on the shortest chains joining two cells of one signature (joint_refutation).
-REFUTE_ROUNDS = 16
+REFUTE_ROUNDS = 24
 
 
 @dataclass(frozen=True)
@@ -64,12 +64,14 @@ class Separation:
     components of G_sigma that hold them; cells in different groups are proved to be different
     components of the joint box minus g(S).  pattern_nodes : nodes standing for a pattern of a
     window-modelled leaf; refuted_contacts, leaves_modelled : edges cut by window models of both ends
-    in the refutation rounds, and the leaves given a window model for them."""
+    in the refutation rounds, and the leaves given a window model for them; rounds : the most rounds
+    one signature used."""
 
     groups: dict[tuple[int, int, int], tuple[tuple[int, ...], ...]]
     pattern_nodes: int = 0
     refuted_contacts: int = 0
     leaves_modelled: int = 0
+    rounds: int = 0
 
     def components_at_least(self) -> int:
         """A proved lower bound on the number of components of the joint box minus g(S) that hold a cell."""
@@ -88,6 +90,7 @@ class Separation:
                 "pattern_nodes": self.pattern_nodes,
                 "refuted_contacts": self.refuted_contacts,
                 "leaves_modelled_for_refutation": self.leaves_modelled,
+                "refutation_rounds": self.rounds,
                 "certified": "cells in different groups of one signature are different components of the joint "
                              "box minus g(S): no chain of face contacts between leaves (or patterns of window-"
                              "modelled leaves) that may hold that signature joins them (proofs/lemma-separation.md, "
@@ -204,8 +207,9 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
     refuter = Refuter(geometry, jp.paving.lo, jp.paving.hi)
     groups: dict[tuple[int, int, int], tuple[tuple[int, ...], ...]] = {}
     size = g.n + len(g.pat.count)
-    refuted = 0
-    for s in sorted({c.signature for c in g.every}):
+    fragment = {c.id for c in jp.fragments}
+    refuted = used = 0
+    for s in sorted({c.signature for c in g.every if c.signature[0] >= 0}):  # a fragment may have no solve
         mine = [c for c in g.every if c.signature == s]
         all_src, all_dst = g.edges(s)
         all_key = np.minimum(all_src, all_dst) * size + np.maximum(all_src, all_dst)
@@ -221,13 +225,18 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
                     raise AssertionError(f"soundness bug: cell {c.id} is not inside one component of G_sigma "
                                          f"for its signature {s}")
                 by_comp.setdefault(int(comp[leaves[0]]), []).append(c.id)
-            merged = [cs for cs in by_comp.values() if len(cs) > 1]
+            # rounds are spent on groups holding two cells; fragments (islands of the local refinement) ride along
+            merged = [[c for c in cs if c not in fragment] for cs in by_comp.values()]
+            merged = [cs for cs in merged if len(cs) > 1]
             if not merged or round_ == rounds:
                 break
             fresh = np.zeros(all_key.size, dtype=bool)
-            for cs in merged:
+            # the chains from the group's first cell to the others, and (three cells or more) to each of them apart:
+            # a pair whose chains cannot be cut (the nearest, or truly joined) must not hide the chains to the others
+            targets = [(cs, cs[1:]) for cs in merged] + [(cs, [c]) for cs in merged if len(cs) > 2 for c in cs[1:]]
+            for cs, to in targets:
                 live = np.flatnonzero(~cut & ~tried & (all_src < g.n) & ~g.inside(all_src, all_dst, s))
-                goal = np.concatenate([g.leaves_of[c] for c in cs[1:]])
+                goal = np.concatenate([g.leaves_of[c] for c in to])
                 pick = live[near_shortest(size, src, dst, g.leaves_of[cs[0]], goal, all_src[live], all_dst[live])]
                 tried[pick] = True
                 fresh[pick[g.refute(refuter, all_src[pick], all_dst[pick], s)]] = True
@@ -236,7 +245,8 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
             cut |= fresh
         groups[s] = tuple(tuple(sorted(cs)) for cs in sorted(by_comp.values()))
         refuted += int(cut.sum())
-    return Separation(groups, len(g.pat.count), refuted, refuter.modelled)
+        used = max(used, round_)
+    return Separation(groups, len(g.pat.count), refuted, refuter.modelled, used)
 
 
 class _Graph:

@@ -137,10 +137,13 @@ def window_refinement(geometry: Geometry, domain: np.ndarray, leaves, stats: lis
     (up to ``levels`` times): its children are tested, given local models and window models in its place.
 
     Near a cusp edge meeting another sheet of g(S) one leaf may hold more roots in play than a window
-    bounds; its halves are smaller and are modelled.  Returns (leaves, paving, windows, finest level).
+    bounds; its halves are smaller and are modelled.  Returns (leaves, paving, windows, finest level, made):
+    ``made`` (n,) bool marks the leaves this step created, which must not start a cell (a clear child is an
+    island inside the undecided layer, as those of the local refinement are).
     """
     paving = leaves_to_paving(domain, leaves, stats)
     found = joint_windows(geometry, paving.lo, paving.hi, store.unresolved(leaves), workers)
+    made = np.zeros(len(paving), dtype=bool)
     for _ in range(levels):
         failed = np.zeros(len(paving), dtype=bool)
         failed[found.leaf[~found.models.ok]] = True
@@ -154,10 +157,11 @@ def window_refinement(geometry: Geometry, domain: np.ndarray, leaves, stats: lis
         paving = leaves_to_paving(domain, leaves, stats)
         children = np.zeros(len(paving), dtype=bool)
         children[kept:] = True
+        made = np.r_[made[~failed], children[kept:]]
         more = joint_windows(geometry, paving.lo, paving.hi, children & store.unresolved(leaves), workers)
         found = found.without(failed[found.leaf], renumber).concat(more)
         found = JointWindows(found.leaf, found.models, found.seconds, found.folds, found.split + int(failed.sum()))
-    return leaves, paving, found, fine
+    return leaves, paving, found, fine, made
 
 
 def _modelled(geometry: Geometry, boxes: np.ndarray) -> tuple[WindowModels, WindowFolds]:
