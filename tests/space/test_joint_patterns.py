@@ -424,15 +424,16 @@ def _synthetic_models(n_windows: int):
 
 def test_patterns_stay_few_and_codes_exact():
     # 5 pair windows (digits 0 or 2): 2**5 combinations, of which those with at most MAX_ROOTS = 6 roots
-    # (at most three pairs) are patterns, codes distinct; 7 windows: 64 left, kept; 8: 93 left, more than
-    # MAX_PATTERNS, none (the box stays one node: a neighbour pair of such boxes once filled 24 GB with pairs
-    # of patterns); 15: past MAX_ENUMERATED, not enumerated
+    # (at most three pairs) are patterns, codes distinct; 11 windows: 232 left, kept; 12: 299 left, more
+    # than MAX_PATTERNS, none (the box stays one node: a neighbour pair of such boxes once filled 24 GB with
+    # pairs of patterns); 15: past MAX_ENUMERATED, not enumerated
     few = jpat.window_patterns(_synthetic_models(5))
     assert len(few.code) == 1 + 5 + 10 + 10 and len(set(few.code.tolist())) == 26
     d = jpat.digits(few, few.code)
     assert d.shape == (26, 5) and set(np.unique(d).tolist()) == {0, 2}
     assert np.array_equal(few.count, d.sum(axis=1)) and few.count.max() == jpat.MAX_ROOTS
-    assert len(jpat.window_patterns(_synthetic_models(7)).code) == 64 == jpat.MAX_PATTERNS
-    for n in (8, 15):
+    assert len(jpat.window_patterns(_synthetic_models(11)).code) == 1 + 11 + 55 + 165 <= jpat.MAX_PATTERNS
+    assert 1 + 12 + 66 + 220 > jpat.MAX_PATTERNS
+    for n in (12, 15):
         assert len(jpat.window_patterns(_synthetic_models(n)).code) == 0
     assert 2 ** 15 > jpat.MAX_ENUMERATED

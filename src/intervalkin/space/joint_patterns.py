@@ -50,7 +50,7 @@ __all__ = ["WindowPatterns", "window_patterns", "pattern_at", "digits", "unit_ov
 #: Base of the pattern codes (one digit per super-window).
 BASE = 8
 #: Boxes that may hold more patterns than this get none (they stay one node of the separation graph).
-MAX_PATTERNS = 64
+MAX_PATTERNS = 256
 #: Roots of f(phi; r) on the circle at most: a trigonometric polynomial of degree 3 that is not identically
 #: zero (a window model proves a derivative or the value nonzero at every point of its box) has at most 6.
 MAX_ROOTS = 6
