@@ -168,3 +168,20 @@ def test_a_piece_holds_the_one_pattern_its_probe_found(graph, fold_paving, paper
                     checked += 1
                     assert refuter._patterns.code[given[slot]] == c, (leaf, slot, n.count)
     assert checked >= 60
+
+
+def test_models_the_paving_made_are_reused_and_change_no_cut(graph, fold_paving, paper_geometry):
+    # a box's window model depends on the box alone, so a refuter handed the paving's models must cut exactly
+    # what one that makes every model itself cuts; the models it took must be the paving's rows
+    rng = np.random.default_rng(8)
+    a, b = _contacts(graph, rng, 300)
+    w = fold_paving.windows
+    fresh = Refuter(paper_geometry, fold_paving.paving.lo, fold_paving.paving.hi)
+    reuse = Refuter(paper_geometry, fold_paving.paving.lo, fold_paving.paving.hi, (w.leaf, w.models))
+    for count in COUNTS:
+        assert np.array_equal(_cut_for(fresh, graph, a, b, count), _cut_for(reuse, graph, a, b, count))
+    took = np.intersect1d(reuse._leaf[~reuse._halves], w.leaf)
+    assert took.size > 20
+    rows = reuse._row[np.searchsorted(reuse._leaf, took)]
+    assert np.array_equal(reuse._models.boxes[rows], w.models.boxes[np.searchsorted(w.leaf, took)])
+    assert np.array_equal(reuse._models.off[rows], w.models.off[np.searchsorted(w.leaf, took)])

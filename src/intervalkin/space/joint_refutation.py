@@ -45,8 +45,11 @@ class Refuter:
     derivative) is modelled as its eight halves instead: a point of the leaf lies in one of them.
     """
 
-    def __init__(self, geometry: Geometry, lo: np.ndarray, hi: np.ndarray):
+    def __init__(self, geometry: Geometry, lo: np.ndarray, hi: np.ndarray, known: tuple | None = None):
+        """``known``: (leaves, models), window models the paving already made (sorted leaves, one row each):
+        taken as they are rather than made again (a box's model depends on the box alone)."""
         self._geometry, self._lo, self._hi = geometry, lo, hi
+        self._known = known
         self._leaf = np.zeros(0, dtype=np.int64)  # the modelled leaves, sorted
         self._row = np.zeros(0, dtype=np.int64)  # the models row of each (its own, or its first half's)
         self._halves = np.zeros(0, dtype=bool)  # modelled as eight halves (rows row .. row + 7)
@@ -54,19 +57,34 @@ class Refuter:
         self._patterns = None
         self.modelled = 0
 
-    def _add(self, boxes: np.ndarray) -> np.ndarray:
-        """Model boxes (k, 3, 2); their rows."""
-        m = window_models(self._geometry, boxes)
+    def _add(self, boxes: np.ndarray, taken: np.ndarray | None = None) -> np.ndarray:
+        """Model boxes (k, 3, 2), the first ones by the paving's models of rows ``taken`` (increasing); their rows."""
+        if taken is not None and taken.size:
+            m = self._known[1].take(taken)
+            if taken.size < len(boxes):
+                m = m.concat(window_models(self._geometry, boxes[taken.size:]))
+        else:
+            m = window_models(self._geometry, boxes)
         first = 0 if self._models is None else len(self._models.ok)
         self._models = m if self._models is None else self._models.concat(m)
         return first + np.arange(len(boxes))
+
+    def _known_first(self, leaves: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """``leaves`` (sorted) reordered with those the paving already modelled first, and their rows there."""
+        if self._known is None or len(self._known[0]) == 0:
+            return leaves, None
+        known = self._known[0]
+        at = np.minimum(np.searchsorted(known, leaves), len(known) - 1)
+        have = known[at] == leaves
+        return np.r_[leaves[have], leaves[~have]], at[have]
 
     def _model(self, leaves: np.ndarray) -> None:
         new = np.setdiff1d(leaves, self._leaf)
         if new.size == 0:
             return
+        new, taken = self._known_first(new)
         lo, hi = self._lo[new], self._hi[new]
-        row = self._add(np.stack([lo, hi], axis=-1))
+        row = self._add(np.stack([lo, hi], axis=-1), taken)
         self._patterns = window_patterns(self._models)
         halves = ~np.isin(row, self._patterns.box)
         if halves.any():

@@ -204,7 +204,8 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
     if jp.windows is None:
         rounds = 0
     g = _Graph(jp, geometry)
-    refuter = Refuter(geometry, jp.paving.lo, jp.paving.hi)
+    w = jp.windows
+    refuter = Refuter(geometry, jp.paving.lo, jp.paving.hi, None if w is None else (w.leaf, w.models))
     groups: dict[tuple[int, int, int], tuple[tuple[int, ...], ...]] = {}
     size = g.n + len(g.pat.count)
     fragment = {c.id for c in jp.fragments}
