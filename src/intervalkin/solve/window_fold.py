@@ -83,6 +83,12 @@ class WindowFolds:
     def __len__(self) -> int:
         return len(self.kind)
 
+    def take(self, rows: np.ndarray, renumber: np.ndarray) -> "WindowFolds":
+        """Rows ``rows``, their window indices mapped by ``renumber`` (WindowModels.window_renumber)."""
+        w = self.window[rows]
+        return WindowFolds(self.kind[rows], np.where(w >= 0, renumber[np.maximum(w, 0)], -1), self.rising[rows],
+                           self.signature[rows], self.edge_rising[rows])
+
     def concat(self, other: "WindowFolds", windows: int) -> "WindowFolds":
         """These rows followed by ``other``'s, whose window indices are shifted by ``windows``."""
         shifted = np.where(other.window >= 0, other.window + windows, -1)

@@ -117,14 +117,18 @@ class WindowModels:
             (self.piece_hi, other.piece_hi), (self.root_box, other.root_box + n), (self.root_lo, other.root_lo),
             (self.root_hi, other.root_hi))))
 
+    def window_renumber(self, rows: np.ndarray) -> np.ndarray:
+        """(w,) the index of each window among those of boxes ``rows`` (increasing), -1 for the others."""
+        keep = np.isin(self.window_box, rows)
+        return np.where(keep, np.cumsum(keep) - 1, -1)
+
     def take(self, rows: np.ndarray) -> "WindowModels":
         """The models of boxes ``rows`` (increasing), with their windows, pieces and root arcs, renumbered."""
         rows = np.asarray(rows, dtype=np.int64)
         new = np.full(len(self.ok), -1, dtype=np.int64)
         new[rows] = np.arange(rows.size)
-        win = np.flatnonzero(new[self.window_box] >= 0)
-        renumber = np.full(len(self.degree), -1, dtype=np.int64)
-        renumber[win] = np.arange(win.size)
+        renumber = self.window_renumber(rows)
+        win = np.flatnonzero(renumber >= 0)
         piece = np.flatnonzero(renumber[self.piece_window] >= 0)
         root = np.flatnonzero(new[self.root_box] >= 0)
         return WindowModels(self.boxes[rows], self.ok[rows], self.off[rows], new[self.window_box[win]],

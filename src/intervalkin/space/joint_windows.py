@@ -16,7 +16,7 @@ and reports its volume apart from the leaves with no model of any kind).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -57,14 +57,7 @@ class JointWindows:
     def without(self, drop: np.ndarray, renumber: np.ndarray) -> "JointWindows":
         """These rows less those marked ``drop`` (k,), their leaves renumbered by ``renumber`` (old -> new)."""
         rows = np.flatnonzero(~drop)
-        folds = self.folds
-        if folds is not None:
-            kept = np.zeros(len(self.models.degree), dtype=np.int64)
-            kept[np.isin(self.models.window_box, rows)] = 1
-            window = np.cumsum(kept) - 1  # windows keep their order: the new index of each kept one
-            w = folds.window[rows]
-            folds = WindowFolds(folds.kind[rows], np.where(w >= 0, window[np.maximum(w, 0)], -1), folds.rising[rows],
-                                folds.signature[rows], folds.edge_rising[rows])
+        folds = None if self.folds is None else self.folds.take(rows, self.models.window_renumber(rows))
         return JointWindows(renumber[self.leaf[rows]], self.models.take(rows), self.seconds, folds, self.split)
 
     def concat(self, other: "JointWindows") -> "JointWindows":
@@ -159,8 +152,7 @@ def window_refinement(geometry: Geometry, domain: np.ndarray, leaves, stats: lis
         children[kept:] = True
         made = np.r_[made[~failed], children[kept:]]
         more = joint_windows(geometry, paving.lo, paving.hi, children & store.unresolved(leaves), workers)
-        found = found.without(failed[found.leaf], renumber).concat(more)
-        found = JointWindows(found.leaf, found.models, found.seconds, found.folds, found.split + int(failed.sum()))
+        found = found.without(failed[found.leaf], renumber).concat(replace(more, split=int(failed.sum())))
     return leaves, paving, found, fine, made
 
 
