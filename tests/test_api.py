@@ -24,12 +24,14 @@ from intervalkin.certify.writer import write_certificates
 from intervalkin.solve import dkp
 from intervalkin.space.pose_label import boxes_holding
 
+from .app.shared import chain
+
 TABLE1_RHO = ("14.98", "15.38", "12.0")
 
 
 @pytest.fixture(scope="module")
 def analysis():
-    return intervalkin.analyse(depth=6)
+    return chain(6)  # intervalkin.analyse(depth=6), made once a session (the figure tests read the same one)
 
 
 # --------------------------------------------------------------------------------------

@@ -331,8 +331,8 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     progress : called with a :class:`ProgressEvent` at the start and end of each stage and after each level.
     refine_to : while Proposition 1 is not seen in full (a sheet of a counted cell holds no certified box),
         pave the regions one level deeper, up to this depth (only undecided boxes are split).
-    while_waiting : work needing the regions and the joint enclosure, not the joint cells (the paper run's
-        trajectories), done while the joint paving runs in its second process.
+    while_waiting : work needing the regions and the joint enclosure, not the joint cells (the chain commands'
+        pavings and figures, the paper run's trajectories), done while the joint paving runs in its second process.
 
     Raises :class:`~intervalkin.core.errors.InputError` on a bad depth and
     :class:`~intervalkin.core.errors.ResourceError` when the run would not fit in memory.
@@ -362,7 +362,7 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
         with stages.stage("aspects: covers proving each sign of det A connected"):
             topology = prove_aspects(geometry)
         if while_waiting is not None:
-            with stages.stage("work beside the joint paving (trajectories)"):
+            with stages.stage("work beside the joint paving (files of the regions, trajectories)"):
                 while_waiting(regions, joint)  # the main process would idle while the joint paving runs
         if future is not None:
             with stages.stage(name + ", in a second process: waiting for it"):

@@ -27,6 +27,7 @@ from intervalkin.app.output import (
     npz_bytes,
     write_analysis_certificates,
     write_chain,
+    write_region_files,
 )
 from intervalkin.app.progress import Stages
 from intervalkin.app.report import write_report
@@ -153,18 +154,26 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
         _begin(folder, geometry)
         early: dict = {}
 
-        def beside(regions, joint):  # the paths need the regions, not the joint cells: found while those are paved
-            early["paths"] = _table1_paths(geometry, regions, joint, st)
+        def table1_paths(regions, joint, files):
+            paths = _table1_paths(geometry, regions, joint, st)
+            st.start("certified trajectories between Table 1's solutions 2, 3, 6")
+            early["trajectories"] = _paper_trajectories(geometry, regions, joint, out, files, paths)
+            st.done()
 
+        def beside(regions, joint):  # needs the regions, not the joint cells: done while those are paved
+            early["files"] = write_region_files(geometry, regions, joint, out, figures, st)
+            if paper:
+                table1_paths(regions, joint, early["files"])
+
+        # with refine_to the regions may be paved again after the joint cells: then everything is written after
         a = analyse(geometry, depth, progress=st, refine_to=refine_to,
-                    while_waiting=beside if paper and refine_to is None else None)
-        summary = write_chain(a, out, figures=figures, stages=st)
+                    while_waiting=beside if refine_to is None else None)
+        summary = write_chain(a, out, figures=figures, stages=st, written=early.get("files"))
         trajs = []
         if paper:  # before the certificates, which re-check these paths
-            st.start("certified trajectories between Table 1's solutions 2, 3, 6")
-            paths = early.get("paths") or _table1_paths(geometry, a.regions, a.joint, st)
-            summary["trajectories"], trajs = _paper_trajectories(a, out, summary["files"], paths)
-            st.done()
+            if "trajectories" not in early:
+                table1_paths(a.regions, a.joint, summary["files"])
+            summary["trajectories"], trajs = early["trajectories"]
         if certificates:
             st.start("certificates")
             summary["files"] += write_analysis_certificates(a, out, trajectories=trajs)
@@ -198,16 +207,17 @@ def _table1_paths(geometry, regions, joint, st: Stages) -> list[tuple[int, int, 
     return out
 
 
-def _paper_trajectories(a: Analysis, out: Path, files: list[str], paths) -> tuple[list[dict], list]:
-    """The files and report entries of the Table 1 paths (one entry per pair, failures included), and the
-    :class:`~intervalkin.space.trajectory.Trajectory` objects found (for the certificates)."""
+def _paper_trajectories(geometry, regions, joint, out: Path, files: list[str], paths) -> tuple[list[dict], list]:
+    """Write the Table 1 paths (their files appended to ``files``); their report entries (one per pair,
+    failures included) and the :class:`~intervalkin.space.trajectory.Trajectory` objects found (for the
+    certificates)."""
     done, found = [], []
     for i, j, tr in paths:
         if isinstance(tr, IntervalkinError):
             done.append({"from": i, "to": j, "certified": False, "reason": str(tr)})
             continue
         folder = out / "trajectories" / f"{i}-{j}"
-        for path in write_trajectory(tr, a.geometry, folder, paving=a.regions.paving, joint=a.joint):
+        for path in write_trajectory(tr, geometry, folder, paving=regions.paving, joint=joint):
             files.append(str(Path(path).relative_to(out)))
         doc = tr.to_json()
         doc["summary"] = tr.summary()

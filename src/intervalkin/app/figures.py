@@ -25,7 +25,7 @@ from intervalkin.app.figures_workspace import render_paving_figures, render_regi
 from intervalkin.app.plotting import pyplot, save_png
 from intervalkin.paving.tree import Paving
 
-__all__ = ["PaperFigure", "PAPER_FIGURES", "render_paper_figures", "render_all", "render_joint", "render_regions",
+__all__ = ["PaperFigure", "PAPER_FIGURES", "render_paper_figures", "render_chain_figures", "render_all", "render_joint", "render_regions",
            "pyplot", "save_png"]
 
 
@@ -80,9 +80,15 @@ def render_regions(analysis, out_dir, base=None, joint=None) -> list[Path]:
 
 def render_paper_figures(analysis, out_dir) -> list[Path]:
     """Every file of :data:`PAPER_FIGURES` for an :class:`~intervalkin.pipeline.Analysis`, into ``out_dir``."""
-    base = analysis.geometry.base
-    return (render_all(analysis.regions.paving, out_dir, base=base) + render_joint(analysis.joint, out_dir)
-            + render_regions(analysis.regions, out_dir, base=base, joint=analysis.joint))
+    return render_chain_figures(analysis.geometry, analysis.regions, analysis.joint, out_dir)
+
+
+def render_chain_figures(geometry, regions, joint, out_dir) -> list[Path]:
+    """:func:`render_paper_figures` from the parts it draws: the regions and the joint enclosure, not the
+    joint cells (so the paper run draws them while the joint paving still runs)."""
+    base = geometry.base
+    return (render_all(regions.paving, out_dir, base=base) + render_joint(joint, out_dir)
+            + render_regions(regions, out_dir, base=base, joint=joint))
 
 
 def _floats(base):

@@ -37,11 +37,11 @@ from typing import Iterator
 import numpy as np
 
 from intervalkin.app.export import write_npz
-from intervalkin.app.figures import render_paper_figures
+from intervalkin.app.figures import render_chain_figures
 from intervalkin.app.progress import Stages
 from intervalkin.app.summary import chain_summary
 from intervalkin.app.table1 import TABLE1_RHO
-from intervalkin.app.vtk_export import write_exports
+from intervalkin.app.vtk_export import write_region_exports
 from intervalkin.core.errors import InputError, IntervalkinError
 from intervalkin.core.files import atomic_write_bytes, watching_writes, write_json
 from intervalkin.core.version import __version__
@@ -49,7 +49,7 @@ from intervalkin.pipeline import Analysis
 from intervalkin.solve.dkp import parse_joint_vector, solve
 
 __all__ = ['MARKER', 'MANIFEST_FORMAT', 'OutputFolder', 'read_manifest', 'writable_folder', 'prepare_output_dir',
-           'write_chain', 'npz_bytes', 'write_analysis_certificates']
+           'write_region_files', 'write_chain', 'npz_bytes', 'write_analysis_certificates']
 
 #: The manifest file that marks an intervalkin output folder.
 MARKER = ".intervalkin-output"
@@ -218,24 +218,40 @@ def prepare_output_dir(out, force: bool, command: str = "intervalkin") -> Path:
     return OutputFolder.open(out, force, command).root
 
 
-def write_chain(a: Analysis, out: Path, figures: bool = True, stages: Stages | None = None) -> dict:
-    """Write pavings (npz, VTK), figures and summary.json of an analysis; returns the summary."""
+def write_region_files(geometry, regions, joint, out: Path, figures: bool = True,
+                       stages: Stages | None = None) -> list[str]:
+    """Write what needs no joint cells: the workspace and joint-enclosure pavings (npz, VTK) and the figures.
+
+    Returns the files written, relative to ``out``.  The chain commands call it while the joint
+    paving still runs in its second process (:func:`intervalkin.pipeline.analyse`, ``while_waiting``).
+    """
     st = stages or Stages(quiet=True)
-    ra = a.regions
-    p = ra.paving
     st.start("writing pavings (npz, VTK)")
-    extra = {"basic_region": ra.region.astype(np.int32), "uniqueness_domain": ra.domain.astype(np.int32)}
-    write_npz(out / "pavings" / "workspace.npz", p, ra.aspect, extra)
-    atomic_write_bytes(out / "pavings" / "joint.npz", npz_bytes(a.joint.columns()))
-    atomic_write_bytes(out / "pavings" / "joint_cells.npz", npz_bytes(a.cells.columns()))
-    vtk_files = write_exports(a, out)
+    extra = {"basic_region": regions.region.astype(np.int32), "uniqueness_domain": regions.domain.astype(np.int32)}
+    write_npz(out / "pavings" / "workspace.npz", regions.paving, regions.aspect, extra)
+    atomic_write_bytes(out / "pavings" / "joint.npz", npz_bytes(joint.columns()))
+    files = ["pavings/workspace.npz", "pavings/joint.npz", *write_region_exports(regions, joint, out)]
     st.done()
-    files = ["pavings/workspace.npz", "pavings/joint.npz", "pavings/joint_cells.npz", *vtk_files]
     if figures:
         st.start("figures")
-        figs = render_paper_figures(a, out / "figures")
-        files += [f"figures/{f.name}" for f in figs]
+        files += [f"figures/{f.name}" for f in render_chain_figures(geometry, regions, joint, out / "figures")]
         st.done()
+    return files
+
+
+def write_chain(a: Analysis, out: Path, figures: bool = True, stages: Stages | None = None,
+                written: list[str] | None = None) -> dict:
+    """Write pavings (npz, VTK), figures and summary.json of an analysis; returns the summary.
+
+    ``written``: the files :func:`write_region_files` already wrote for these regions (not written again).
+    """
+    st = stages or Stages(quiet=True)
+    files = list(written) if written is not None else write_region_files(a.geometry, a.regions, a.joint, out,
+                                                                          figures, st)
+    st.start("writing the joint cells (npz)")
+    atomic_write_bytes(out / "pavings" / "joint_cells.npz", npz_bytes(a.cells.columns()))
+    st.done()
+    files.insert(2, "pavings/joint_cells.npz")
     summary = {"complete": False, **chain_summary(a)}
     summary["timings_seconds"] = {**a.timings, **st.timings}
     summary["files"] = files

@@ -69,8 +69,9 @@ class Stages:
     def done(self) -> None:
         """The current stage ends: its time is kept under its name."""
         self._close_bar()
-        if self._name is not None:
+        if self._name is not None:  # once: a library stage may end after sub-stages the caller timed inside it
             self.timings[self._name] = time.perf_counter() - self._start
+            self._name = None
 
     # -- bars -------------------------------------------------------------------------------
     def _close_bar(self) -> None:

@@ -39,7 +39,7 @@ from intervalkin.paving.tree import Paving
 from intervalkin.space.basic_region import RegionAnalysis
 
 __all__ = ["write_vtu_paving", "workspace_fields", "write_workspace_vtu", "write_joint_vtu",
-           "write_region_surfaces", "write_exports", "read_vtu", "SURFACE_BITS"]
+           "write_region_surfaces", "write_exports", "write_region_exports", "read_vtu", "SURFACE_BITS"]
 
 #: Grid of the region surfaces: 2**7 cells per axis (x, y steps of 0.5, phi steps of 2.8 deg).
 SURFACE_BITS = 7
@@ -218,8 +218,13 @@ def write_exports(analysis, out, phi_unit="deg") -> list[str]:
 
     Returns the paths written, relative to ``out`` (for summary.json's file list).
     """
+    return write_region_exports(analysis.regions, analysis.joint, out, phi_unit)
+
+
+def write_region_exports(regions, joint, out, phi_unit="deg") -> list[str]:
+    """:func:`write_exports` from the regions and the joint enclosure (the joint cells are not drawn)."""
     out = Path(out)
-    paths = [write_workspace_vtu(out / "pavings" / "workspace.vtu", analysis.regions, phi_unit),
-             write_joint_vtu(out / "pavings" / "joint.vtu", analysis.joint)]
-    paths += write_region_surfaces(out / "pavings" / "surfaces", analysis.regions, phi_unit)
+    paths = [write_workspace_vtu(out / "pavings" / "workspace.vtu", regions, phi_unit),
+             write_joint_vtu(out / "pavings" / "joint.vtu", joint)]
+    paths += write_region_surfaces(out / "pavings" / "surfaces", regions, phi_unit)
     return [str(Path(p).relative_to(out)) for p in paths]
