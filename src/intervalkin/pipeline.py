@@ -53,8 +53,10 @@ from intervalkin.space.basic_region import (
     label_pose,
 )
 from intervalkin.space.joint_cells import regions_from_cells
+from intervalkin.space.joint_closure import Closure, closed_cells
 from intervalkin.space.joint_paving import DEFAULT_JOINT_DEPTH, FACE_LEVELS, JOIN_LEVELS, MODEL_LEVELS, JointSpacePaving
 from intervalkin.space.joint_paving import pave_joint_space as pave_joint_cells
+from intervalkin.space.joint_separation import Separation, separated_cells
 from intervalkin.space.joint_space import JointPaving, joint_paving
 from intervalkin.space.pose_label import PoseLabel
 from intervalkin.space.singular_surface import pave_singular_layer
@@ -146,6 +148,10 @@ class Analysis:
     timings : seconds per stage, keyed by the stage names of the progress events.
     refinement : each depth the regions paving was tried at, and why it stopped.
     aspect_topology : the covers proving each sign's part of W connected (the aspects' upper bound).
+    closure, separation : what is proved of the cells' topology: the cells that are whole components
+        (:func:`~intervalkin.space.joint_closure.closed_cells`) and the cells of one signature that are
+        different components (:func:`~intervalkin.space.joint_separation.separated_cells`); library proofs,
+        not yet in the certificates.
     """
 
     geometry: Geometry
@@ -158,6 +164,8 @@ class Analysis:
     timings: Mapping[str, float]
     refinement: tuple[RefinementStep, ...]
     aspect_topology: AspectTopology | None = None
+    closure: Closure | None = None
+    separation: Separation | None = None
 
     @property
     def n_singular_boxes(self) -> int:
@@ -298,6 +306,14 @@ class _Stages:
                                                          fraction=float(done), detail=detail))
 
 
+def _joint_cells(geometry: Geometry, depth: int, join_levels: int, progress=None,
+                 **levels) -> tuple[JointSpacePaving, Closure, Separation]:
+    """The joint box paved directly, with the cells proved closed and the cells proved apart (one task: the paper
+    run gives it its second process, so the separations' half minute runs beside the regions, not after them)."""
+    cells = pave_joint_cells(geometry, depth, join_levels, progress=progress, **levels)
+    return cells, closed_cells(cells, geometry), separated_cells(cells, geometry)
+
+
 def _joint_space(geometry: Geometry, singular_depth: int, joint_depth: int, stages: _Stages) -> JointPaving:
     with stages.stage(f"singular layer (depth {singular_depth})") as levels:
         singular = pave_singular_layer(geometry, singular_depth, progress=levels)
@@ -345,7 +361,8 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     full = dj - 1 >= DEFAULT_JOINT_DEPTH  # below it a preview: one local level, no window models (separations need them)
     levels = {"model_levels": MODEL_LEVELS if full else 1, "face_levels": FACE_LEVELS if full else 0, "windows": full}
     name = (f"joint space paved directly (depth {dj - 1}, local models{', window models' if full else ''}, "
-            f"{levels['model_levels']} + {levels['face_levels']} levels of local and face refinement, {JOIN_LEVELS} join levels)")
+            f"{levels['model_levels']} + {levels['face_levels']} levels of local and face refinement, {JOIN_LEVELS} join levels; "
+            "closed cells, separations)")
     with contextlib.ExitStack() as side:
         future = None
         daemonic = multiprocessing.current_process().daemon
@@ -353,10 +370,10 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
             # the two pavings are independent: the joint one runs in a second process beside the regions
             # (not from a daemonic process, such as a Dask worker, which may not have children: in-process there)
             pool = side.enter_context(ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")))
-            future = pool.submit(pave_joint_cells, geometry, dj - 1, JOIN_LEVELS, **levels)
+            future = pool.submit(_joint_cells, geometry, dj - 1, JOIN_LEVELS, **levels)
         else:
             with stages.stage(name) as report:
-                cells = pave_joint_cells(geometry, dj - 1, JOIN_LEVELS, progress=report, **levels)
+                cells, closure, separation = _joint_cells(geometry, dj - 1, JOIN_LEVELS, progress=report, **levels)
         with stages.stage(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})") as levels:
             regions = analyse_regions(geometry, joint, dw, progress=levels)
         with stages.stage("aspects: covers proving each sign of det A connected"):
@@ -366,7 +383,7 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
                 while_waiting(regions, joint)  # the main process would idle while the joint paving runs
         if future is not None:
             with stages.stage(name + ", in a second process: waiting for it"):
-                cells = future.result()
+                cells, closure, separation = future.result()
     history = [RefinementStep(dw, regions.consistent, len(regions.regions))]
     while refine_to is not None and not regions.consistent and dw < refine_to:
         dw += 1
@@ -380,7 +397,8 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     else:
         stopped = f"limit reached (depth {dw}) before consistency"
     history[-1] = dataclasses.replace(history[-1], stopped=stopped)
-    return Analysis(geometry, dw, ds, dj, joint, cells, regions, dict(stages.timings), tuple(history), topology)
+    return Analysis(geometry, dw, ds, dj, joint, cells, regions, dict(stages.timings), tuple(history), topology,
+                    closure, separation)
 
 
 def verify(path: str | Path) -> VerifyReport:

@@ -108,10 +108,11 @@ def joint_summary(jp: JointPaving) -> dict:
     }
 
 
-def joint_cells_summary(jp, geometry=None) -> dict:
+def joint_cells_summary(jp, geometry=None, closure=None, separation=None) -> dict:
     """The direct joint paving: its resolution, certified share, cells (each with its certified count) and levels;
     with ``geometry``, the cells proved closed (whole components; :mod:`intervalkin.space.joint_closure`) and the
-    cells proved to be different components (:mod:`intervalkin.space.joint_separation`)."""
+    cells proved to be different components (:mod:`intervalkin.space.joint_separation`): ``closure`` and
+    ``separation`` when given (an analysis has them), computed here otherwise."""
     stats = jp.paving.stats
     uniform = [st for st in stats if st["stage"] == "joint paving"]
     fs = jp.fold_stats
@@ -137,8 +138,9 @@ def joint_cells_summary(jp, geometry=None) -> dict:
         "empty_pieces": int(fs.get("empty_pieces", 0)),
         "window_models": dict(fs.get("windows", {})),
         "open_places": jp.open_places()["places"],
-        **({} if geometry is None else {"closed_cells": closed_cells(jp, geometry).to_json(),
-                                        "separations": separated_cells(jp, geometry).to_json()}),
+        **({} if geometry is None else {
+            "closed_cells": (closed_cells(jp, geometry) if closure is None else closure).to_json(),
+            "separations": (separated_cells(jp, geometry) if separation is None else separation).to_json()}),
         "certified": "every box of a cell is proved off g(S) (no singular pose has its joint vector in it: by the "
                      "torus search or by Krawczyk exclusion), or is a fold box: one sheet of g(S) crosses it as a "
                      "certified graph and each of its two pieces is joined to the cell through a point placed in "
@@ -172,7 +174,7 @@ def chain_summary(a: Analysis) -> dict:
             "WA2": {"boxes": p.count_by_label("WA2"), "volume": p.volume_by_label("WA2")},
             "aspect_components": list(ra.aspect_info),
             "joint": joint_summary(a.joint),
-            "joint_cells": joint_cells_summary(a.cells, a.geometry),
+            "joint_cells": joint_cells_summary(a.cells, a.geometry, a.closure, a.separation),
             "basic_region_list": [r.to_json() for r in ra.regions],
             "uniqueness_domain_list": [list(g) for g in ra.domains],
             "consistency": list(ra.consistency),
