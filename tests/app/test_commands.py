@@ -184,3 +184,20 @@ def test_refinement_deepens_until_consistent_or_limit():
     assert h[-1].stopped and not any(step.stopped for step in h[:-1])
     with pytest.raises(InputError, match=r"^refine_to: expected an integer in 5\.\.9, got 4$"):
         analyse(None, 5, refine_to=4)
+
+
+@pytest.mark.parametrize("depth, extra", [(4, []), (5, ["--refine-to", "6"])])
+def test_files_written_beside_the_joint_paving_or_after_it_are_the_regions_of_the_summary(tmp_path, depth, extra):
+    """Without --refine-to the regions' files are written while the joint cells are paved; with it the regions
+    may be paved again afterwards, so everything is written after: either way the workspace paving on disk is the
+    one the summary describes, and every file listed exists."""
+    out = tmp_path / "run"
+    assert main(["analyze", "--depth", str(depth), "--out", str(out), "--quiet", *extra]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    files = s["files"]
+    assert len(files) == len(set(files)) and all((out / f).is_file() for f in files)
+    assert {"pavings/workspace.npz", "pavings/joint.npz", "pavings/joint_cells.npz", "pavings/workspace.vtu"} <= set(files)
+    assert any(f.startswith("figures/") for f in files) and any(f.startswith("certificates/") for f in files)
+    with np.load(out / "pavings" / "workspace.npz") as z:
+        assert z["lo"].shape[0] == sum(s["W"]["boxes"].values())
+    assert s["depth"]["workspace"] == s["refinement"][-1]["depth"] == (6 if extra else depth)  # depth 5 is refined

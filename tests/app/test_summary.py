@@ -49,3 +49,27 @@ def test_a_separation_bound_that_meets_the_count_says_so_and_stays_a_lower_bound
     row = next(line for line in chain_table(s).splitlines() if line.startswith("basic regions"))
     assert "at least 22 by separations" in row and "the count found: no upper bound yet" in row
     assert not row.rstrip().endswith("exact")
+
+
+def test_the_chain_summary_reads_the_analysis_topology_without_recomputing_it(monkeypatch):
+    """The closed cells and separations come with the analysis (computed beside the regions, in the joint
+    paving's process); the summary reports those and computes neither again."""
+    import intervalkin.app.summary as summary
+    from intervalkin.space.joint_closure import closed_cells
+    from intervalkin.space.joint_separation import separated_cells
+
+    from .shared import chain
+
+    a = chain(6)
+    assert a.closure is not None and a.separation is not None
+    assert a.separation.to_json() == separated_cells(a.cells, a.geometry).to_json()
+    assert a.closure.to_json() == closed_cells(a.cells, a.geometry).to_json()
+
+    def again(*args, **kwargs):
+        raise AssertionError("the summary computed the cells' topology again")
+
+    monkeypatch.setattr(summary, "separated_cells", again)
+    monkeypatch.setattr(summary, "closed_cells", again)
+    s = summary.chain_summary(a)
+    assert s["joint_cells"]["separations"] == a.separation.to_json()
+    assert s["joint_cells"]["closed_cells"] == a.closure.to_json()
