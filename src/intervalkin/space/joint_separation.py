@@ -213,9 +213,9 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
     for s in sorted({c.signature for c in g.every if c.signature[0] >= 0}):  # a fragment may have no solve
         mine = [c for c in g.every if c.signature == s]
         all_src, all_dst = g.edges(s)
-        all_key = np.minimum(all_src, all_dst) * size + np.maximum(all_src, all_dst)
-        cut = np.zeros(all_key.size, dtype=bool)
-        tried = np.zeros(all_key.size, dtype=bool)
+        cut = np.zeros(all_src.size, dtype=bool)
+        tried = np.zeros(all_src.size, dtype=bool)
+        within = g.inside(all_src, all_dst, s)  # edges inside one cell: cutting them separates nothing
         for round_ in range(rounds + 1):
             src, dst = all_src[~cut], all_dst[~cut]
             comp = _components(size, src, dst)
@@ -231,12 +231,12 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
             merged = [cs for cs in merged if len(cs) > 1]
             if not merged or round_ == rounds:
                 break
-            fresh = np.zeros(all_key.size, dtype=bool)
+            fresh = np.zeros(all_src.size, dtype=bool)
             # the chains from the group's first cell to the others, and (three cells or more) to each of them apart:
             # a pair whose chains cannot be cut (the nearest, or truly joined) must not hide the chains to the others
             targets = [(cs, cs[1:]) for cs in merged] + [(cs, [c]) for cs in merged if len(cs) > 2 for c in cs[1:]]
             for cs, to in targets:
-                live = np.flatnonzero(~cut & ~tried & (all_src < g.n) & ~g.inside(all_src, all_dst, s))
+                live = np.flatnonzero(~cut & ~tried & (all_src < g.n) & ~within)
                 goal = np.concatenate([g.leaves_of[c] for c in to])
                 pick = live[near_shortest(size, src, dst, g.leaves_of[cs[0]], goal, all_src[live], all_dst[live])]
                 tried[pick] = True
