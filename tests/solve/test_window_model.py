@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 import dataclasses
+import inspect
 from fractions import Fraction
 
 import mpmath
@@ -147,10 +148,16 @@ def _mp_value(coeff: dict, phi, deriv: int = 0):
     return sum(c * (1j * k) ** deriv * w**k for k, c in coeff.items()).real
 
 
+_ASCENDING = "asc" in inspect.signature(mpmath.polyroots).parameters
+
+
 def _roots_on_circle(coeff: dict) -> list | None:
     """The angles of the roots of f on the circle (z^3 f(z), degree 6, 50 digits); None if one is too close to call."""
-    poly = [coeff.get(k, 0) for k in range(3, -4, -1)]
-    roots = mpmath.polyroots(poly, maxsteps=200, extraprec=200)
+    poly = [coeff.get(k, 0) for k in range(3, -4, -1)]  # highest degree first
+    if _ASCENDING:  # mpmath >= 1.4 deprecates the descending order
+        roots = mpmath.polyroots(poly[::-1], maxsteps=200, extraprec=200, asc=True)
+    else:
+        roots = mpmath.polyroots(poly, maxsteps=200, extraprec=200)
     out = []
     for z in roots:
         gap = abs(abs(z) - 1)
