@@ -278,3 +278,42 @@ def test_json_object_and_outputs(paths, paper_geometry, chain, tmp_path):
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp files left
     back = json.loads((tmp_path / "trajectory.json").read_text())
     assert back["certificate"]["segments"][0]["certified"] is True
+
+
+def test_the_box_path_is_a_shortest_one(paper_geometry, chain, solutions):
+    """The A* search between two of Table 1's solutions returns a chain of face-adjacent boxes of the aspect
+    whose length (centre to centre, the search's metric) is the one scipy's Dijkstra finds for the same graph."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    from intervalkin.paving.labels import Label
+    from intervalkin.space.path_search import _point_box_distance, metric_length, path_distance, shortest_box_path
+
+    _, ra = chain
+    paving, edges = ra.paving, ra.edges
+    L = metric_length(paper_geometry)
+    start, goal = (np.array([float(v) for v in solutions[k].midpoint]) for k in (1, 2))
+    path = shortest_box_path(paving, edges, "WA1", start, goal, L)
+    assert path is not None and len(path) > 2
+    inside = paving.labels["WA1"] == Label.INSIDE
+    assert inside[path].all()
+    pairs = {(int(a), int(b)) for a, b in edges.T} | {(int(b), int(a)) for a, b in edges.T}
+    assert all((int(a), int(b)) in pairs for a, b in zip(path[:-1], path[1:]))
+    centre = 0.5 * (paving.lo + paving.hi)
+    length = float(path_distance(centre[path[:-1]], centre[path[1:]], L).sum())
+    # the same graph for Dijkstra: the aspect's boxes, face contacts weighted by the same metric
+    nodes = np.flatnonzero(inside)
+    local = np.full(len(paving), -1)
+    local[nodes] = np.arange(nodes.size)
+    e = edges[:, inside[edges[0]] & inside[edges[1]]]
+    key = np.unique(np.minimum(local[e[0]], local[e[1]]) * nodes.size + np.maximum(local[e[0]], local[e[1]]))
+    u, v = key // nodes.size, key % nodes.size
+    w = path_distance(centre[nodes[u]], centre[nodes[v]], L)
+    graph = csr_matrix((w, (u, v)), shape=(nodes.size, nodes.size))
+    ends = local[path[[0, -1]]]
+    best = dijkstra(graph, directed=False, indices=ends[0])[ends[1]]
+    assert abs(length - best) <= 1e-9 * max(1.0, best), (length, best)
+    # the ends are the boxes nearest the two poses
+    for pose, box in ((start, path[0]), (goal, path[-1])):
+        gap = _point_box_distance(pose, paving.lo[nodes], paving.hi[nodes], L)
+        assert gap[local[box]] == gap.min()

@@ -93,25 +93,28 @@ def shortest_box_path(paving: Paving, edges: np.ndarray, name: str, start: np.nd
     indptr = np.concatenate([[0], np.cumsum(np.bincount(u, minlength=nodes.size))]).tolist()
     nbr, wt = v.tolist(), w.tolist()
     h = path_distance(centre, centre[t], L).tolist()  # consistent heuristic: the same metric
-    dist = {s: 0.0}
-    prev = {s: -1}
+    # flat lists, not dicts and sets: the loop below is the path search's hot spot (pure Python, one node at a time)
+    dist = [math.inf] * nodes.size
+    prev = [-2] * nodes.size  # -2: not reached; -1: the start
+    closed = bytearray(nodes.size)
+    dist[s], prev[s] = 0.0, -1
     heap = [(h[s], 0.0, s)]
-    closed = set()
+    pop, push = heapq.heappop, heapq.heappush
     while heap:
-        _, g, a = heapq.heappop(heap)
-        if a in closed:
+        _, g, a = pop(heap)
+        if closed[a]:
             continue
         if a == t:
             break
-        closed.add(a)
+        closed[a] = 1
         for k in range(indptr[a], indptr[a + 1]):
             b = nbr[k]
             nd = g + wt[k]
-            if nd < dist.get(b, math.inf):
+            if nd < dist[b]:
                 dist[b] = nd
                 prev[b] = a
-                heapq.heappush(heap, (nd + h[b], nd, b))
-    if t not in prev:
+                push(heap, (nd + h[b], nd, b))
+    if prev[t] == -2:
         return None
     path = [t]
     while prev[path[-1]] >= 0:
