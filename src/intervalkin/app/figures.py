@@ -25,8 +25,8 @@ from intervalkin.app.figures_workspace import render_paving_figures, render_regi
 from intervalkin.app.plotting import pyplot, save_png
 from intervalkin.paving.tree import Paving
 
-__all__ = ["PaperFigure", "PAPER_FIGURES", "render_paper_figures", "render_chain_figures", "render_all", "render_joint", "render_regions",
-           "pyplot", "save_png"]
+__all__ = ["PaperFigure", "PAPER_FIGURES", "render_paper_figures", "render_chain_figures", "render_all", "render_joint",
+           "render_regions", "pyplot", "save_png"]
 
 
 @dataclass(frozen=True)

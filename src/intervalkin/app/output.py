@@ -251,7 +251,7 @@ def write_chain(a: Analysis, out: Path, figures: bool = True, stages: Stages | N
     st.start("writing the joint cells (npz)")
     atomic_write_bytes(out / "pavings" / "joint_cells.npz", npz_bytes(a.cells.columns()))
     st.done()
-    files.insert(2, "pavings/joint_cells.npz")
+    files.append("pavings/joint_cells.npz")
     summary = {"complete": False, **chain_summary(a)}
     summary["timings_seconds"] = {**a.timings, **st.timings}
     summary["files"] = files
