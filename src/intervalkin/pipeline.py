@@ -53,11 +53,11 @@ from intervalkin.space.basic_region import (
     label_pose,
 )
 from intervalkin.space.joint_cells import regions_from_cells
-from intervalkin.space.joint_closure import Closure, closed_cells
+from intervalkin.space.joint_closure import Closure
 from intervalkin.space.joint_paving import DEFAULT_JOINT_DEPTH, FACE_LEVELS, JOIN_LEVELS, MODEL_LEVELS, JointSpacePaving
-from intervalkin.space.joint_paving import pave_joint_space as pave_joint_cells
-from intervalkin.space.joint_separation import Separation, separated_cells
+from intervalkin.space.joint_separation import Separation
 from intervalkin.space.joint_space import JointPaving, joint_paving
+from intervalkin.space.joint_topology import pave_joint_topology
 from intervalkin.space.pose_label import PoseLabel
 from intervalkin.space.singular_surface import pave_singular_layer
 
@@ -306,14 +306,6 @@ class _Stages:
                                                          fraction=float(done), detail=detail))
 
 
-def _joint_cells(geometry: Geometry, depth: int, join_levels: int, progress=None,
-                 **levels) -> tuple[JointSpacePaving, Closure, Separation]:
-    """The joint box paved directly, with the cells proved closed and the cells proved apart (one task: the paper
-    run gives it its second process, so the separations' half minute runs beside the regions, not after them)."""
-    cells = pave_joint_cells(geometry, depth, join_levels, progress=progress, **levels)
-    return cells, closed_cells(cells, geometry), separated_cells(cells, geometry)
-
-
 def _joint_space(geometry: Geometry, singular_depth: int, joint_depth: int, stages: _Stages) -> JointPaving:
     with stages.stage(f"singular layer (depth {singular_depth})") as levels:
         singular = pave_singular_layer(geometry, singular_depth, progress=levels)
@@ -370,10 +362,10 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
             # the two pavings are independent: the joint one runs in a second process beside the regions
             # (not from a daemonic process, such as a Dask worker, which may not have children: in-process there)
             pool = side.enter_context(ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")))
-            future = pool.submit(_joint_cells, geometry, dj - 1, JOIN_LEVELS, **levels)
+            future = pool.submit(pave_joint_topology, geometry, dj - 1, JOIN_LEVELS, **levels)
         else:
             with stages.stage(name) as report:
-                cells, closure, separation = _joint_cells(geometry, dj - 1, JOIN_LEVELS, progress=report, **levels)
+                cells, closure, separation = pave_joint_topology(geometry, dj - 1, JOIN_LEVELS, progress=report, **levels)
         with stages.stage(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})") as levels:
             regions = analyse_regions(geometry, joint, dw, progress=levels)
         with stages.stage("aspects: covers proving each sign of det A connected"):
