@@ -43,7 +43,7 @@ from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.geometry import Geometry, default_geometry
 from intervalkin.core.status import Status
 from intervalkin.paving.budget import check_depth
-from intervalkin.recheck import recheck_folder
+from intervalkin.recheck import recheck_folder, recheck_separations
 from intervalkin.solve import dkp
 from intervalkin.space.aspect_topology import AspectTopology, prove_aspects
 from intervalkin.space.basic_region import (
@@ -407,4 +407,5 @@ def verify(path: str | Path) -> VerifyReport:
     folder = root / "certificates" if (root / "certificates" / INDEX).is_file() else root
     results = tuple(verify_directory(folder))
     everything = recheck_folder(root)
-    return VerifyReport(folder, results + (() if everything is None else (everything,)))
+    barriers = tuple(recheck_separations(root))
+    return VerifyReport(folder, results + barriers + (() if everything is None else (everything,)))

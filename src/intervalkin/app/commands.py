@@ -33,6 +33,7 @@ from intervalkin.app.progress import Stages
 from intervalkin.app.report import write_report
 from intervalkin.app.report_html import write_report_html
 from intervalkin.app.summary import (
+    add_barrier_certificates,
     chain_table,
     joint_summary,
     joint_table,
@@ -177,6 +178,9 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
         if certificates:
             st.start("certificates")
             summary["files"] += write_analysis_certificates(a, out, trajectories=trajs)
+            if (out / "certificates" / "joint_separation.json").is_file():
+                barriers = json.loads((out / "certificates" / "joint_separation.json").read_text(encoding="utf-8"))
+                add_barrier_certificates(summary, barriers["claims"])
             st.done()
         if paper:
             st.start("paper report")

@@ -213,6 +213,31 @@ def add_separation_bound(summary: dict) -> None:
                      "certificates, so intervalkin verify does not re-prove that bound")
 
 
+def add_barrier_certificates(summary: dict, claims: list[dict]) -> None:
+    """Record in ``joint_cells.separations.count_barriers`` the separations written as count barriers
+    (``certificates/joint_separation.json``, re-proved by ``intervalkin verify``).
+
+    Each claim tells its cell apart from every other cell of its signature, so a signature with k claims
+    has at least k + 1 components certified (the k cells and any one other are pairwise apart)."""
+    sep = (summary.get("joint_cells") or {}).get("separations")
+    if sep is None or not claims:
+        return
+    by_sig: dict[tuple, list[int]] = {}
+    for c in claims:
+        by_sig.setdefault(tuple(c["signature"]), []).append(int(c["cell"]))
+    rows = [{"signature": list(sig), "cells": sorted(cells), "components_at_least": len(cells) + 1}
+            for sig, cells in sorted(by_sig.items())]
+    sep["count_barriers"] = {
+        "by_signature": rows,
+        "components_at_least": sum(r["components_at_least"] for r in rows),
+        "basic_regions_at_least": sum(r["components_at_least"] * r["signature"][0] for r in rows),
+        "file": "certificates/joint_separation.json",
+        "certified": "each listed cell and every other cell of its signature lie in different components of the "
+                     "joint box minus g(S): a region around its witness whose boundary carries no point of its "
+                     "count (proofs/lemma-count-barrier.md, lemma-count-range.md), re-proved by intervalkin verify",
+    }
+
+
 def chain_table(summary: dict) -> str:
     """A short terminal table of the counts and their status."""
     def status(block):

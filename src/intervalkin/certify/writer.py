@@ -105,6 +105,14 @@ Claim fields by kind (``id`` is unique within its file):
     declared count and split and lie in one component of the open joint box minus g(S):
     each clear node is re-proved off g(S), each link lies in both its nodes
     (:mod:`intervalkin.checker.joint_join`).
+``joint_separation.json`` and ``joint_separation.npz`` (beside the index, not listed in its
+    ``files``: the arb checker does not read them; ``intervalkin verify`` re-proves them with
+    :mod:`intervalkin.recheck.separation_file`)
+    one claim per count barrier (:mod:`intervalkin.certify.separation_claims`): ``cell``,
+    ``signature``, ``witness`` and ``others`` (witness objects as in a joint_cell claim),
+    ``region`` (the claim's number: the npz rows ``region_lo/hi`` and ``barrier_lo/hi`` whose
+    ``region_claim`` / ``barrier_claim`` equal it).  Proves: the cell's witness and the others
+    lie in different components of the joint box minus g(S).
 ``counts``
     one claim per count: ``name`` (``aspects``, ``basic_regions``,
     ``uniqueness_domains``), ``lower_bound``, ``upper_bound`` (null: none
@@ -123,8 +131,11 @@ import dataclasses
 from pathlib import Path
 from typing import Sequence
 
+import numpy as np
+
 from intervalkin.certify.aspect_claims import aspect_connected_claims
 from intervalkin.certify.joint_claims import joint_claims
+from intervalkin.certify.separation_claims import separation_claims
 from intervalkin.certify.solve_claims import (
     dkp_claim,
     joint_cell_claims,
@@ -138,9 +149,12 @@ from intervalkin.certify.workspace_claims import (
 )
 from intervalkin.checker import FORMAT, INDEX, KINDS, VERSION
 from intervalkin.core.errors import InputError
-from intervalkin.core.files import write_json
+from intervalkin.core.files import atomic_write, write_json
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.version import __version__
+
+#: The count barriers (:mod:`intervalkin.certify.separation_claims`), written beside the claim files.
+SEPARATION_JSON, SEPARATION_NPZ = "joint_separation.json", "joint_separation.npz"
 
 __all__ = ['write_certificates']
 
@@ -249,6 +263,10 @@ def write_certificates(
             counts = dataclasses.replace(counts, aspects=aspect_topology.count(counts.aspects))
         files["counts"] = counts_claims(regions, aspect_refs, solve_refs, counts)
 
+    separations = separation_claims(geometry, joint_cells, precision) if joint_cells is not None else None
+    if separations is not None:
+        omitted += separations[2]
+
     written = []
     for kind in KINDS:
         if kind not in files:
@@ -256,6 +274,12 @@ def write_certificates(
         written.append(write_json(out / f"{kind}.json", {
             "format": FORMAT, "version": VERSION, "kind": kind, "geometry_toml": toml,
             "precision": precision, "claims": files[kind]}, indent=1))
+    beside = []
+    if separations is not None and separations[0]:
+        beside = [write_json(out / SEPARATION_JSON, {
+            "format": FORMAT, "version": VERSION, "kind": "joint_separation", "geometry_toml": toml,
+            "claims": separations[0]}, indent=1),
+            atomic_write(out / SEPARATION_NPZ, lambda fh: np.savez_compressed(fh, **separations[1]))]
     index = {
         "format": FORMAT,
         "version": VERSION,
@@ -264,7 +288,8 @@ def write_certificates(
         "files": [p.name for p in written],
         "tool": {"name": "intervalkin", "version": __version__},
         "omitted": omitted,
+        "beside": [p.name for p in beside],
         "how_to_check": "intervalkin verify DIR (or intervalkin.checker.verify_directory(DIR))",
     }
     written.append(write_json(out / INDEX, index, indent=1))
-    return written
+    return written + beside

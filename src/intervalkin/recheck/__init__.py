@@ -23,6 +23,11 @@ Modules, from the ground up:
     every claimed label confirmed, refuted or left open, with vectorised bisection.
 :mod:`~intervalkin.recheck.paving_file`
     ``pavings/workspace.npz`` read and validated, re-checked in full, one verdict.
+:mod:`~intervalkin.recheck.reduced_equation`, :mod:`~intervalkin.recheck.count_range`
+    the reduced equation and its phi-derivatives over joint boxes; proved ranges of the number of
+    solutions at every point of a joint box.
+:mod:`~intervalkin.recheck.separation_file`
+    ``certificates/joint_separation.*``: count barriers between joint cells, re-proved.
 """
 
 from intervalkin.recheck.paving_file import (
@@ -34,6 +39,7 @@ from intervalkin.recheck.paving_file import (
     recheck_folder,
     recheck_paving,
 )
+from intervalkin.recheck.separation_file import recheck_separations
 
 __all__ = ['KIND', 'RecheckReport', 'WorkspaceLabels', 'find_paving', 'read_workspace_labels',
-           'recheck_folder', 'recheck_paving']
+           'recheck_folder', 'recheck_paving', 'recheck_separations']

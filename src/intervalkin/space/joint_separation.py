@@ -27,9 +27,12 @@ leaf's piece to be connected, only which signatures it can hold.
 What is certified: for each signature, the number of groups of G_sigma that hold a cell is a
 lower bound on the number of components with that signature; summed with the counts it is
 a lower bound on the basic regions (Theorem 1: above a component with n_1 solutions in WA1
-and n_2 in WA2 lie n_1 + n_2 basic regions).  What is not: these separations are not yet
-written into the certificates, so ``intervalkin verify`` does not re-prove them, and the
-printed lower bounds do not use them.
+and n_2 in WA2 lie n_1 + n_2 basic regions).  What is not: the graphs are not written into the
+certificates.  Where a *count barrier* exists (a region around a cell whose boundary carries no
+point of its count, :mod:`intervalkin.certify.separation_claims`), the separation is also written
+to ``certificates/joint_separation.json`` and re-proved by ``intervalkin verify``; the others
+(cells told apart only by the patterns of window models) are re-proved by nothing yet, and the
+printed certified lower bounds use none of them.
 """
 
 from __future__ import annotations
@@ -94,9 +97,9 @@ class Separation:
                 "certified": "cells in different groups of one signature are different components of the joint "
                              "box minus g(S): no chain of face contacts between leaves (or patterns of window-"
                              "modelled leaves) that may hold that signature joins them (proofs/lemma-separation.md, "
-                             "lemma-window-patterns.md, lemma-refuted-contact.md); proved by the library, not yet in "
-                             "the certificates, so intervalkin verify does not re-prove it and the certified lower "
-                             "bounds printed elsewhere do not use it"}
+                             "lemma-window-patterns.md, lemma-refuted-contact.md); proved by the library; the ones "
+                             "a count barrier also proves are in certificates/joint_separation.json, re-proved by "
+                             "intervalkin verify (count_barriers); the certified count bounds do not use them yet"}
 
 
 def leaf_signatures(jp) -> np.ndarray:

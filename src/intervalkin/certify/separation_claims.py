@@ -1,0 +1,199 @@
+"""Separation certificates: count barriers that put two joint cells of one signature in different components.
+
+A *count barrier* for a cell C with c solutions is a finite set S of closed joint boxes (the
+*region*) and a set of closed face rectangles (the *barrier*) such that
+
+* the boundary of S inside the open joint box lies in the union of the barrier rectangles;
+* no point of any barrier rectangle has exactly c solutions (proved by
+  :func:`intervalkin.recheck.count_range.count_ranges`);
+* a witness of C lies in the interior of a box of S, and a witness of every other cell of
+  C's signature lies outside S.
+
+A path off g(S) from C's witness to another witness keeps c solutions at every point
+(lemma-constant-count-off-gS.md); leaving S, it would cross the boundary of S at a point with c
+solutions, on a barrier rectangle.  So the witnesses lie in different components of the joint
+box minus g(S) (proofs/lemma-count-barrier.md).  ``intervalkin verify`` re-proves every
+barrier rectangle and the covering of the boundary from the files alone
+(:mod:`intervalkin.recheck.separation_file`).
+
+How a region is found (a choice of effort, not of soundness): the leaves of the joint paving that
+may hold c solutions (:func:`~intervalkin.space.joint_separation.possible_counts`), joined through
+shared faces, form components; C's component, if it holds no leaf of another cell of its
+signature, is the first region.  Its boundary faces are tested; the leaf beyond each face whose
+count is not excluded is added (the barrier moves away from g(S), where the roots of the reduced
+equation are better apart), for at most :data:`GROW_ROUNDS` rounds.  Patterns of window models
+are not used: cells told apart only by the patterns of their solutions (the transversal
+crossings of two sheets) get no count barrier, and stay library-proved.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from intervalkin.certify.evidence import box_json, certified
+from intervalkin.core.exact import exact_text
+from intervalkin.core.geometry import Geometry
+from intervalkin.paving.adjacency import shares_face
+from intervalkin.recheck.count_range import count_ranges, supported
+from intervalkin.solve.dkp import solve
+from intervalkin.space.joint_closure import piece_cells
+from intervalkin.space.joint_separation import ANY, possible_counts
+
+__all__ = ["GROW_ROUNDS", "FACE_BUDGET", "CountBarrier", "count_barriers", "separation_claims"]
+
+#: Rounds of moving failed faces outward before a region is given up.
+GROW_ROUNDS = 8
+#: Face rectangles tested per region at most (each costs about a millisecond of count ranges).
+FACE_BUDGET = 30000
+
+
+@dataclass(frozen=True)
+class CountBarrier:
+    """A region (closed boxes) holding ``cell``'s leaves and a barrier of faces with no point of ``count``
+    solutions covering its boundary; ``others`` the cells of the same signature left outside."""
+
+    cell: int
+    signature: tuple[int, int, int]
+    others: tuple[int, ...]
+    region_lo: np.ndarray
+    region_hi: np.ndarray
+    barrier_lo: np.ndarray
+    barrier_hi: np.ndarray
+    witness: tuple[Fraction, Fraction, Fraction]
+    other_witnesses: tuple[tuple[Fraction, Fraction, Fraction], ...]
+
+
+def _centre(p, leaf: int) -> tuple[Fraction, Fraction, Fraction]:
+    return tuple(Fraction(float(v)) for v in 0.5 * (p.lo[leaf] + p.hi[leaf]))
+
+
+def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET) -> tuple[list[CountBarrier], list[dict]]:
+    """Count barriers for the cells of ``jp`` (a :class:`~intervalkin.space.joint_paving.JointSpacePaving`):
+    for each signature held by two cells or more, one barrier per cell but the one with the largest
+    region (enough to tell every pair apart), where one is found; and what was left out, with why."""
+    if not supported(geometry):
+        return [], [{"what": "count barriers", "why": "|p_i| = |A_i - A_1| for legs 2 and 3: count ranges refused"}]
+    p = jp.paving
+    n = len(p.lo)
+    a, b = shares_face(p.level, p.ijk, int(p.level.max()), periodic=(False, False, False))
+    counts = possible_counts(jp)
+    cells = piece_cells(jp)[0]
+    barriers, omitted = [], []
+    by_sig: dict[tuple, list] = {}
+    for c in jp.cells:
+        if c.signature[0] >= 0 and np.any(jp.cell == c.id):
+            by_sig.setdefault(c.signature, []).append(c)
+    for sig, mine in sorted(by_sig.items()):
+        if len(mine) < 2:
+            continue
+        count = sig[0]
+        admit = (counts == ANY) | ((counts >> count) & 1 == 1)
+        keep = admit[a] & admit[b]
+        comp = connected_components(coo_matrix((np.ones(int(keep.sum()), dtype=np.int8), (a[keep], b[keep])),
+                                               shape=(n, n)), directed=False)[1]
+        leaves = {c.id: np.flatnonzero((cells == c.id).any(axis=1)) for c in mine}
+        size = {c.id: int(np.sum(comp == comp[leaves[c.id][0]])) for c in mine}
+        order = sorted(mine, key=lambda c: size[c.id])
+        for c in order[:-1]:
+            others = [o for o in mine if o.id != c.id]
+            found, why = _grow(geometry, p, a, b, comp == comp[leaves[c.id][0]], count,
+                               np.concatenate([leaves[o.id] for o in others]), face_budget)
+            if found is None:
+                omitted.append({"what": f"count barrier of cell {c.id} ({count} solutions)", "why": why})
+                continue
+            region, faces = found
+            clear = lambda cid: int(np.flatnonzero(jp.cell == cid)[0])  # noqa: E731 - a clear leaf of the cell
+            barriers.append(CountBarrier(
+                c.id, tuple(int(v) for v in sig), tuple(o.id for o in others), p.lo[region], p.hi[region],
+                np.maximum(p.lo[a[faces]], p.lo[b[faces]]), np.minimum(p.hi[a[faces]], p.hi[b[faces]]),
+                _centre(p, clear(c.id)), tuple(_centre(p, clear(o.id)) for o in others)))
+    return barriers, omitted
+
+
+def _grow(geometry: Geometry, p, a: np.ndarray, b: np.ndarray, region: np.ndarray, count: int,
+          forbidden: np.ndarray, budget: int) -> tuple[tuple[np.ndarray, np.ndarray] | None, str]:
+    """(region leaves, boundary contacts) once every boundary face excludes ``count``; or (None, why)."""
+    region = region.copy()
+    proved: dict[int, bool] = {}
+    for _ in range(GROW_ROUNDS + 1):
+        if region[forbidden].any():
+            return None, "its region reaches another cell of its signature (a finer paving, or the patterns of window models, would be needed)"
+        edge = np.flatnonzero(region[a] ^ region[b])
+        todo = np.array([e for e in edge.tolist() if e not in proved], dtype=np.int64)
+        if len(proved) + todo.size > budget:
+            return None, f"more than {budget} faces to test"
+        if todo.size:
+            lo = np.maximum(p.lo[a[todo]], p.lo[b[todo]])
+            hi = np.minimum(p.hi[a[todo]], p.hi[b[todo]])
+            proved.update(zip(todo.tolist(), count_ranges(geometry, lo, hi).excludes(count).tolist()))
+        fail = np.array([e for e in edge.tolist() if not proved[e]], dtype=np.int64)
+        if fail.size == 0:
+            return (np.flatnonzero(region), edge), ""
+        region[np.where(region[a[fail]], b[fail], a[fail])] = True
+    return None, f"faces with {count} solutions not excluded after {GROW_ROUNDS} rounds"
+
+
+def _end(geometry: Geometry, q, precision: int) -> tuple[dict | None, str]:
+    """A witness with its complete, checker-verified solution list (a ``joint_cell``-shaped object)."""
+    res = solve(geometry, q)
+    sols = [{"box": box_json(s.box), "det_sign": int(s.det_sign)}
+            for s in res.solutions if s.status == "unique" and s.det_sign != 0]
+    if not res.complete or len(sols) != len(res.solutions):
+        return None, "the solve of a witness is not complete"
+    n1 = sum(1 for s in sols if s["det_sign"] > 0)
+    claim = {"id": "end", "witness": [exact_text(v) for v in q], "count": len(sols), "n_wa1": n1,
+             "n_wa2": len(sols) - n1, "phi0": 0.0, "solutions": sols}
+    got, why = certified(geometry, "joint_cell", claim, max(precision, res.precision))
+    if got is None:
+        return None, why
+    del got["id"]
+    return got, ""
+
+
+def separation_claims(geometry: Geometry, jp, precision: int = 128) -> tuple[list[dict], dict, list[dict]]:
+    """(claims, npz arrays, omitted) of ``certificates/joint_separation.json`` and ``.npz``.
+
+    Claim j: ``cell``, ``signature``, ``witness`` and ``others`` (each a witness object with its
+    complete solution list, as in a ``joint_cell`` claim, plus ``cell``), ``region`` (j itself: the
+    rows of the npz whose ``region_claim`` / ``barrier_claim`` is j)."""
+    barriers, omitted = count_barriers(jp, geometry)
+    claims: list[dict] = []
+    arrays = {k: [] for k in ("region_lo", "region_hi", "region_claim", "barrier_lo", "barrier_hi", "barrier_claim")}
+    for bar in barriers:
+        ends = [_end(geometry, q, precision) for q in (bar.witness, *bar.other_witnesses)]
+        bad = next((why for got, why in ends if got is None), None)
+        if bad is not None:
+            omitted.append({"what": f"count barrier of cell {bar.cell}", "why": bad})
+            continue
+        if any((e["count"], e["n_wa1"], e["n_wa2"]) != bar.signature for e, _ in ends):
+            omitted.append({"what": f"count barrier of cell {bar.cell}", "why": "a witness's signature differs"})
+            continue
+        j = len(claims)
+        claims.append({
+            "id": f"cell-{bar.cell}",
+            "cell": bar.cell,
+            "signature": list(bar.signature),
+            "witness": ends[0][0],
+            "others": [dict(e, cell=int(o)) for (e, _), o in zip(ends[1:], bar.others)],
+            "region": j,
+            "statement": (f"joint cell {bar.cell} ({bar.signature[0]} solutions, {bar.signature[1]} in WA1) lies in "
+                          f"another component of the joint box minus g(S) than cells "
+                          f"{', '.join(map(str, bar.others))}: {len(bar.region_lo)} boxes around its witness, whose "
+                          f"boundary is covered by {len(bar.barrier_lo)} face rectangles with no point of "
+                          f"{bar.signature[0]} solutions"),
+        })
+        for name, value in (("region", (bar.region_lo, bar.region_hi)), ("barrier", (bar.barrier_lo, bar.barrier_hi))):
+            arrays[f"{name}_lo"].append(value[0])
+            arrays[f"{name}_hi"].append(value[1])
+            arrays[f"{name}_claim"].append(np.full(len(value[0]), j, dtype=np.int64))
+    out = {k: (np.concatenate(v) if v else np.zeros((0, 3) if not k.endswith("claim") else 0))
+           for k, v in arrays.items()}
+    for k in out:
+        if k.endswith("claim"):
+            out[k] = out[k].astype(np.int64)
+    return claims, out, omitted

@@ -1,0 +1,122 @@
+"""Count barriers: built on a joint paving of the paper's manipulator, re-proved from the files, and refused
+when the files are made false.
+
+The paving is the depth-5 paving with window models of ``tests/conftest.py`` (``fold_paving``).  Every
+mutation below breaks exactly one hypothesis of proofs/lemma-count-barrier.md and must be refused.
+"""
+
+from __future__ import annotations
+
+import json
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from intervalkin.certify.separation_claims import separation_claims
+from intervalkin.checker.parse import Refused
+from intervalkin.core.errors import CertificateFormatError
+from intervalkin.core.files import write_json
+from intervalkin.recheck.separation_file import ARRAYS, CLAIMS, check_separation, recheck_separations
+from intervalkin.solve.dkp import solve
+
+
+@pytest.fixture(scope="module")
+def built(fold_paving, paper_geometry):
+    claims, arrays, omitted = separation_claims(paper_geometry, fold_paving)
+    return claims, arrays, omitted
+
+
+def _parts(arrays, j):
+    r, w = arrays["region_claim"] == j, arrays["barrier_claim"] == j
+    return (arrays["region_lo"][r], arrays["region_hi"][r]), (arrays["barrier_lo"][w], arrays["barrier_hi"][w])
+
+
+def test_the_barriers_of_the_paper_paving_verify(built, paper_geometry):
+    claims, arrays, omitted = built
+    # the four cells without solutions: three barriers tell them all apart; the cells with solutions meet at
+    # transversal crossings of two sheets, where only the patterns of window models tell them apart
+    assert len(claims) == 3 and {c["signature"][0] for c in claims} == {0}
+    assert any("another cell of its signature" in o["why"] for o in omitted)
+    rng = np.random.default_rng(5)
+    for j, claim in enumerate(claims):
+        region, barrier = _parts(arrays, j)
+        msg, facts = check_separation(paper_geometry, claim, region, barrier)
+        assert facts["cell"] == claim["cell"] and len(facts["others"]) == 3
+        # the barrier is what the lemma needs it to be: sampled, it never holds a point of the count
+        for i in rng.choice(len(barrier[0]), 40, replace=False):
+            q = tuple(Fraction(float(v)) for v in rng.uniform(barrier[0][i], barrier[1][i]))
+            res = solve(paper_geometry, q)
+            assert not res.complete or len(res.solutions) != claim["signature"][0]
+
+
+def test_a_missing_barrier_face_is_refused(built, paper_geometry):
+    claims, arrays, _ = built
+    region, barrier = _parts(arrays, 0)
+    with pytest.raises(Refused, match="lie on no barrier box"):
+        check_separation(paper_geometry, claims[0], region, (barrier[0][1:], barrier[1][1:]))
+
+
+def test_a_region_box_taken_away_is_refused(built, paper_geometry):
+    """Without one of its inner boxes the region has a hole whose walls carry no barrier."""
+    claims, arrays, _ = built
+    region, barrier = _parts(arrays, 1)
+    lo, hi = region
+    inner = [i for i in range(len(lo)) if not np.any(np.isin(lo[i], barrier[0]))]
+    drop = inner[len(inner) // 2]
+    keep = np.arange(len(lo)) != drop
+    with pytest.raises(Refused):
+        check_separation(paper_geometry, claims[1], (lo[keep], hi[keep]), barrier)
+
+
+def test_a_barrier_face_with_points_of_the_count_is_refused(built, paper_geometry):
+    claims, arrays, _ = built
+    region, barrier = _parts(arrays, 0)
+    x = np.array([float(Fraction(v)) for v in claims[0]["witness"]["witness"]])
+    inside = (np.vstack([barrier[0], x - 1e-3]), np.vstack([barrier[1], x + 1e-3]))
+    with pytest.raises(Refused, match="not proved free of 0 solutions"):
+        check_separation(paper_geometry, claims[0], region, inside)
+
+
+def test_a_witness_outside_the_region_is_refused(built, paper_geometry):
+    claims, arrays, _ = built
+    region, barrier = _parts(arrays, 0)
+    swapped = dict(claims[0], witness=claims[0]["others"][0], others=[claims[0]["witness"]])
+    with pytest.raises(Refused, match="not inside a box of the region"):
+        check_separation(paper_geometry, swapped, region, barrier)
+
+
+def test_another_cell_inside_the_region_is_refused(built, paper_geometry):
+    claims, arrays, _ = built
+    region, barrier = _parts(arrays, 0)
+    same = dict(claims[0], others=[claims[0]["witness"]])
+    with pytest.raises(Refused, match="may lie in the region"):
+        check_separation(paper_geometry, same, region, barrier)
+
+
+def test_a_false_signature_is_refused(built, paper_geometry):
+    claims, arrays, _ = built
+    region, barrier = _parts(arrays, 0)
+    with pytest.raises(Refused, match="not the claimed signature"):
+        check_separation(paper_geometry, dict(claims[0], signature=[2, 1, 1]), region, barrier)
+
+
+def test_the_folder_is_read_and_a_corrupt_file_is_a_format_error(built, paper_geometry, tmp_path):
+    claims, arrays, _ = built
+    cert = tmp_path / "certificates"
+    write_json(cert / "index.json", {"geometry_toml": paper_geometry.to_toml()})
+    write_json(tmp_path / CLAIMS, {"claims": claims[:1]})
+    keep = {k: v for k, v in arrays.items()}
+    for name in ("region", "barrier"):
+        rows = keep[f"{name}_claim"] == 0
+        for col in ("lo", "hi", "claim"):
+            keep[f"{name}_{col}"] = keep[f"{name}_{col}"][rows]
+    np.savez(tmp_path / ARRAYS, **keep)
+    results = recheck_separations(tmp_path)
+    assert len(results) == 1 and results[0].verified and results[0].kind == "joint_separation"
+    assert recheck_separations(cert)[0].verified  # the certificates folder itself is accepted too
+    (tmp_path / ARRAYS).write_bytes(b"not an npz")
+    with pytest.raises(CertificateFormatError, match="cannot read"):
+        recheck_separations(tmp_path)
+    assert recheck_separations(tmp_path / "nothing") == []
+    json.loads((tmp_path / CLAIMS).read_text())
