@@ -73,3 +73,22 @@ def test_the_chain_summary_reads_the_analysis_topology_without_recomputing_it(mo
     s = summary.chain_summary(a)
     assert s["joint_cells"]["separations"] == a.separation.to_json()
     assert s["joint_cells"]["closed_cells"] == a.closure.to_json()
+
+
+def test_count_barriers_are_reported_beside_the_separations():
+    """Each barrier claim tells its cell from every other cell of its signature: k claims, k + 1 components; the
+    other signatures count one component each (their witnesses' splits differ)."""
+    from intervalkin.app.summary import add_barrier_certificates
+
+    summary = {"joint_cells": {"separations": {"by_signature": [
+        {"signature": [0, 0, 0]}, {"signature": [2, 1, 1]}, {"signature": [4, 2, 2]}]}}}
+    claims = [{"cell": 7, "signature": [0, 0, 0]}, {"cell": 6, "signature": [0, 0, 0]},
+              {"cell": 3, "signature": [4, 2, 2]}]
+    add_barrier_certificates(summary, claims)
+    got = summary["joint_cells"]["separations"]["count_barriers"]
+    assert [r["components_at_least"] for r in got["by_signature"]] == [3, 2]
+    assert got["components_at_least"] == 5 and got["all_components_at_least"] == 3 + 1 + 2
+    assert got["basic_regions_at_least"] == 2 * 4
+    empty = {"joint_cells": {"separations": {"by_signature": []}}}
+    add_barrier_certificates(empty, [])
+    assert "count_barriers" not in empty["joint_cells"]["separations"]

@@ -227,9 +227,13 @@ def add_barrier_certificates(summary: dict, claims: list[dict]) -> None:
         by_sig.setdefault(tuple(c["signature"]), []).append(int(c["cell"]))
     rows = [{"signature": list(sig), "cells": sorted(cells), "components_at_least": len(cells) + 1}
             for sig, cells in sorted(by_sig.items())]
+    barred = {tuple(r["signature"]): r["components_at_least"] for r in rows}
+    signatures = {tuple(b["signature"]) for b in sep.get("by_signature", [])} | set(barred)
     sep["count_barriers"] = {
         "by_signature": rows,
         "components_at_least": sum(r["components_at_least"] for r in rows),
+        # cells of different signatures are different components (their witnesses' joint_cell claims)
+        "all_components_at_least": sum(barred.get(sig, 1) for sig in signatures),
         "basic_regions_at_least": sum(r["components_at_least"] * r["signature"][0] for r in rows),
         "file": "certificates/joint_separation.json",
         "certified": "each listed cell and every other cell of its signature lie in different components of the "
