@@ -55,7 +55,8 @@ def cert_dir(tmp_path_factory, paper_geometry, chain, table1, paths, aspect_topo
     jp, ra = chain
     out = tmp_path_factory.mktemp("certificates")
     write_certificates(out, paper_geometry, dkp_results=[table1], joint=jp, regions=ra, box_sample=120, seed=7,
-                       trajectories=paths, aspect_topology=aspect_topology, joint_cells=fold_paving)
+                       trajectories=paths, aspect_topology=aspect_topology, joint_cells=fold_paving,
+                       separations=False)  # count barriers: tests/recheck/test_separation_file.py
     return out
 
 

@@ -43,7 +43,7 @@ MODELS = "joint_fold_model.json"
 @pytest.fixture(scope="module")
 def written(tmp_path_factory, paper_geometry, fold_paving):
     out = tmp_path_factory.mktemp("joint-claims")
-    write_certificates(out, paper_geometry, joint_cells=fold_paving)
+    write_certificates(out, paper_geometry, joint_cells=fold_paving, separations=False)
     return out
 
 

@@ -38,6 +38,7 @@ from scipy.sparse.csgraph import connected_components
 from intervalkin.certify.evidence import box_json, certified
 from intervalkin.core.exact import exact_text
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Workers, default_workers
 from intervalkin.paving.adjacency import shares_face
 from intervalkin.recheck.count_range import count_ranges, supported
 from intervalkin.solve.dkp import solve
@@ -48,8 +49,10 @@ __all__ = ["GROW_ROUNDS", "FACE_BUDGET", "CountBarrier", "count_barriers", "sepa
 
 #: Rounds of moving failed faces outward before a region is given up.
 GROW_ROUNDS = 8
-#: Face rectangles tested per region at most (each costs about a millisecond of count ranges).
+#: Face rectangles tested per region at most (each costs a few milliseconds of count ranges).
 FACE_BUDGET = 30000
+#: Faces worth sending to a second process at once.
+MIN_PART = 400
 
 
 @dataclass(frozen=True)
@@ -72,7 +75,8 @@ def _centre(p, leaf: int) -> tuple[Fraction, Fraction, Fraction]:
     return tuple(Fraction(float(v)) for v in 0.5 * (p.lo[leaf] + p.hi[leaf]))
 
 
-def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET) -> tuple[list[CountBarrier], list[dict]]:
+def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET,
+                   workers: Workers | None = None) -> tuple[list[CountBarrier], list[dict]]:
     """Count barriers for the cells of ``jp`` (a :class:`~intervalkin.space.joint_paving.JointSpacePaving`):
     for each signature held by two cells or more, one barrier per cell but the one with the largest
     region (enough to tell every pair apart), where one is found; and what was left out, with why."""
@@ -102,7 +106,7 @@ def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET) -> tu
         for c in order[:-1]:
             others = [o for o in mine if o.id != c.id]
             found, why = _grow(geometry, p, a, b, comp == comp[leaves[c.id][0]], count,
-                               np.concatenate([leaves[o.id] for o in others]), face_budget)
+                               np.concatenate([leaves[o.id] for o in others]), face_budget, workers)
             if found is None:
                 omitted.append({"what": f"count barrier of cell {c.id} ({count} solutions)", "why": why})
                 continue
@@ -116,7 +120,7 @@ def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET) -> tu
 
 
 def _grow(geometry: Geometry, p, a: np.ndarray, b: np.ndarray, region: np.ndarray, count: int,
-          forbidden: np.ndarray, budget: int) -> tuple[tuple[np.ndarray, np.ndarray] | None, str]:
+          forbidden: np.ndarray, budget: int, workers: Workers | None) -> tuple[tuple[np.ndarray, np.ndarray] | None, str]:
     """(region leaves, boundary contacts) once every boundary face excludes ``count``; or (None, why)."""
     region = region.copy()
     proved: dict[int, bool] = {}
@@ -130,7 +134,7 @@ def _grow(geometry: Geometry, p, a: np.ndarray, b: np.ndarray, region: np.ndarra
         if todo.size:
             lo = np.maximum(p.lo[a[todo]], p.lo[b[todo]])
             hi = np.minimum(p.hi[a[todo]], p.hi[b[todo]])
-            proved.update(zip(todo.tolist(), count_ranges(geometry, lo, hi).excludes(count).tolist()))
+            proved.update(zip(todo.tolist(), count_ranges(geometry, lo, hi, workers=workers).excludes(count).tolist()))
         fail = np.array([e for e in edge.tolist() if not proved[e]], dtype=np.int64)
         if fail.size == 0:
             return (np.flatnonzero(region), edge), ""
@@ -161,7 +165,8 @@ def separation_claims(geometry: Geometry, jp, precision: int = 128) -> tuple[lis
     Claim j: ``cell``, ``signature``, ``witness`` and ``others`` (each a witness object with its
     complete solution list, as in a ``joint_cell`` claim, plus ``cell``), ``region`` (j itself: the
     rows of the npz whose ``region_claim`` / ``barrier_claim`` is j)."""
-    barriers, omitted = count_barriers(jp, geometry)
+    with Workers(default_workers(), min_items=MIN_PART) as workers:
+        barriers, omitted = count_barriers(jp, geometry, workers=workers)
     claims: list[dict] = []
     arrays = {k: [] for k in ("region_lo", "region_hi", "region_claim", "barrier_lo", "barrier_hi", "barrier_claim")}
     for bar in barriers:

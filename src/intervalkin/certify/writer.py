@@ -174,6 +174,7 @@ def write_certificates(
     counts=None,
     aspect_topology=None,
     joint_cells=None,
+    separations: bool = True,
 ) -> list[Path]:
     """Write the certificate folder of the given results; return the paths written (index last).
 
@@ -202,7 +203,9 @@ def write_certificates(
         pre-check: ``intervalkin verify`` re-proves them.
     joint_cells : :class:`~intervalkin.space.joint_paving.JointSpacePaving` -> ``joint_fold_model.json``
         and ``joint_join.json`` when it has fold pieces (a capped selection, each claim checked
-        first: :mod:`~intervalkin.certify.joint_claims`).
+        first: :mod:`~intervalkin.certify.joint_claims`); with ``separations`` also the count barriers
+        ``joint_separation.json`` and ``.npz`` beside the claim files (:mod:`~intervalkin.certify.separation_claims`:
+        tens of seconds on the default paving; ``intervalkin verify`` re-proves them).
 
     Every solve claim is re-checked with :mod:`intervalkin.checker` before it
     is written; refused ones are listed under ``omitted`` in ``index.json``.
@@ -263,9 +266,9 @@ def write_certificates(
             counts = dataclasses.replace(counts, aspects=aspect_topology.count(counts.aspects))
         files["counts"] = counts_claims(regions, aspect_refs, solve_refs, counts)
 
-    separations = separation_claims(geometry, joint_cells, precision) if joint_cells is not None else None
-    if separations is not None:
-        omitted += separations[2]
+    barriers = separation_claims(geometry, joint_cells, precision) if joint_cells is not None and separations else None
+    if barriers is not None:
+        omitted += barriers[2]
 
     written = []
     for kind in KINDS:
@@ -275,11 +278,11 @@ def write_certificates(
             "format": FORMAT, "version": VERSION, "kind": kind, "geometry_toml": toml,
             "precision": precision, "claims": files[kind]}, indent=1))
     beside = []
-    if separations is not None and separations[0]:
+    if barriers is not None and barriers[0]:
         beside = [write_json(out / SEPARATION_JSON, {
             "format": FORMAT, "version": VERSION, "kind": "joint_separation", "geometry_toml": toml,
-            "claims": separations[0]}, indent=1),
-            atomic_write(out / SEPARATION_NPZ, lambda fh: np.savez_compressed(fh, **separations[1]))]
+            "claims": barriers[0]}, indent=1),
+            atomic_write(out / SEPARATION_NPZ, lambda fh: np.savez_compressed(fh, **barriers[1]))]
     index = {
         "format": FORMAT,
         "version": VERSION,

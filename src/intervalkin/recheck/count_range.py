@@ -7,18 +7,20 @@ pieces, and on each piece P the first of these holds for every r in R^2 (d = 0 .
 
     the d-th phi-derivative of f(phi; r) has one strict sign on P.
 
-Rolle's theorem then bounds the roots of f(.; r) in P, counted with multiplicity, by d (d = 0: no
-root).  When the signs of f at both ends of P are proved non-zero over R^2, the number with
+Consecutive pieces with the same order and sign form a *run*, on which that sign holds throughout.
+Rolle's theorem then bounds the roots of f(.; r) in a run, counted with multiplicity, by d (d = 0: no
+root).  When the signs of f at both ends of the run are proved non-zero over R^2, the number with
 multiplicity is odd exactly when they differ, so the bound drops to d - 1 when its parity is
 wrong.  The solutions at q number at most the roots of f(.; q^2) with multiplicity (a root with
 D != 0 carries one solution, a root with D = 0 is multiple and carries at most two), and every
-root lies in some (closed) piece: the sum of the pieces' bounds is ``hi``.  A piece whose bound is
-1 with end signs that differ holds exactly one root, simple, so exactly one solution (a root with
-D = 0 is multiple); such pieces are disjoint apart from their ends, where f != 0: their number is
-``lo``.  The argument is ``proofs/lemma-count-range.md``.
+root lies in some (closed) run: the sum of the runs' bounds is ``hi``.  Between two consecutive
+points where f has proved opposite signs, on an arc where D != 0 is proved, f has a root that
+carries exactly one solution; the number of such arcs is ``lo``.  The argument is
+``proofs/lemma-count-range.md``.
 
 Pieces are found by bisection, vectorised over every (box, piece): a piece on which no derivative
-order up to 3 has a proved sign is cut in two, at most ``depth`` times.
+order up to 3 has a proved sign is cut in two, at most ``depth`` times; a piece where only the
+second or third derivative has one is cut too, until the last :data:`HIGH_ORDER_LEVELS` halvings.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Workers
 from intervalkin.recheck.arith import PI_HI, PI_LO, down, up
 from intervalkin.recheck.reduced_equation import ReducedConstants, d_sign, derivative_enclosures, reduced_constants, \
     sign_at_points
@@ -199,16 +202,29 @@ def arc_ranges(k: ReducedConstants, r_lo: np.ndarray, r_hi: np.ndarray, box: np.
     return CountRanges(lo_count, np.minimum(hi_count, NO_BOUND))
 
 
+def _ranges_part(geometry: Geometry, q_lo: np.ndarray, q_hi: np.ndarray, pieces: int, depth: int) -> tuple:
+    r_lo, r_hi = r_box(q_lo, q_hi)
+    n = q_lo.shape[0]
+    got = arc_ranges(reduced_constants(geometry), r_lo, r_hi, np.arange(n), np.full(n, -np.pi), np.full(n, np.pi),
+                     pieces, depth)
+    return got.lo, got.hi
+
+
 def count_ranges(geometry: Geometry, q_lo: np.ndarray, q_hi: np.ndarray, pieces: int = PIECES,
-                 depth: int = DEPTH) -> CountRanges:
+                 depth: int = DEPTH, workers: Workers | None = None) -> CountRanges:
     """At every point of each joint box [q_lo[i], q_hi[i]] (n, 3), the number of solutions lies in [lo, hi].
 
-    Raises ValueError for a geometry :func:`supported` refuses and for malformed boxes."""
+    ``workers`` (:class:`~intervalkin.core.workers.Workers`) may share the boxes between processes: each box's
+    range is computed on its own, so the answer is the same.  Raises ValueError for a geometry
+    :func:`supported` refuses and for malformed boxes."""
     if not supported(geometry):
         raise ValueError("count ranges need |p_i| != |A_i - A_1| for leg 2 or leg 3")
     q_lo, q_hi = np.atleast_2d(q_lo), np.atleast_2d(q_hi)
-    r_lo, r_hi = r_box(q_lo, q_hi)
+    r_box(q_lo, q_hi)  # validates every box before any part is sent away
     n = q_lo.shape[0]
-    k = reduced_constants(geometry)
-    box = np.arange(n)
-    return arc_ranges(k, r_lo, r_hi, box, np.full(n, -np.pi), np.full(n, np.pi), pieces, depth)
+    parts = [(0, n)] if workers is None else workers.parts(n)
+    got = (workers.run if workers is not None else lambda fn, calls: [fn(*c) for c in calls])(
+        _ranges_part, [(geometry, q_lo[a:b], q_hi[a:b], pieces, depth) for a, b in parts])
+    if not got:
+        return CountRanges(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
+    return CountRanges(np.concatenate([g[0] for g in got]), np.concatenate([g[1] for g in got]))

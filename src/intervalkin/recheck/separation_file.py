@@ -39,6 +39,7 @@ from intervalkin.checker.folder import CheckResult
 from intervalkin.checker.parse import Refused
 from intervalkin.core.errors import CertificateFormatError
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Workers, default_workers
 from intervalkin.recheck.arith import fraction_enclosure
 from intervalkin.recheck.count_range import count_ranges, supported
 from intervalkin.recheck.paving_file import folder_geometry
@@ -50,6 +51,8 @@ CLAIMS = Path("certificates") / "joint_separation.json"
 ARRAYS = Path("certificates") / "joint_separation.npz"
 #: The kind of the result lines ``verify`` prints for them.
 KIND = "joint_separation"
+#: Barrier boxes worth sending to a second process at once.
+MIN_PART = 400
 _COLUMNS = ("region_lo", "region_hi", "region_claim", "barrier_lo", "barrier_hi", "barrier_claim")
 
 
@@ -118,8 +121,9 @@ def _enclose(q: tuple[Fraction, ...]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def check_separation(geometry: Geometry, claim: dict, region: tuple[np.ndarray, np.ndarray],
-                     barrier: tuple[np.ndarray, np.ndarray]) -> tuple[str, dict]:
-    """Re-prove one claim (module docstring); (statement, facts) or :class:`Refused`."""
+                     barrier: tuple[np.ndarray, np.ndarray], workers: Workers | None = None) -> tuple[str, dict]:
+    """Re-prove one claim (module docstring); (statement, facts) or :class:`Refused`.  ``workers`` may share
+    the count ranges of the barrier boxes between processes (the same verdict)."""
     sig = claim.get("signature")
     if not (isinstance(sig, list) and len(sig) == 3 and all(isinstance(v, int) and 0 <= v <= 6 for v in sig)):
         raise Refused(f"signature: expected [count, n_wa1, n_wa2], got {sig!r}")
@@ -153,7 +157,7 @@ def check_separation(geometry: Geometry, claim: dict, region: tuple[np.ndarray, 
         if np.any(np.all((r_lo <= y_hi) & (y_lo <= r_hi), axis=1)):
             raise Refused(f"others[{k}]: its witness may lie in the region")
         cells.append(other.get("cell"))
-    free = count_ranges(geometry, b_lo, b_hi).excludes(sig[0]) if b_lo.size else np.zeros(0, dtype=bool)
+    free = count_ranges(geometry, b_lo, b_hi, workers=workers).excludes(sig[0]) if b_lo.size else np.zeros(0, dtype=bool)
     if not free.all():
         i = int(np.flatnonzero(~free)[0])
         raise Refused(f"{int((~free).sum())} barrier boxes not proved free of {sig[0]} solutions, the first "
@@ -202,17 +206,22 @@ def recheck_separations(folder: str | Path) -> list[CheckResult]:
     doc, arrays = _read(root)
     geometry = folder_geometry(root / "pavings" / "workspace.npz")
     out = []
-    for j, claim in enumerate(doc["claims"]):
-        t0 = time.perf_counter()
-        name = claim.get("id", f"#{j}") if isinstance(claim, dict) else f"#{j}"
-        try:
-            if not isinstance(claim, dict) or claim.get("region") != j:
-                raise Refused(f"claim {j}: expected an object whose region is {j}")
-            rows = arrays["region_claim"] == j
-            walls = arrays["barrier_claim"] == j
-            msg, _ = check_separation(geometry, claim, (arrays["region_lo"][rows], arrays["region_hi"][rows]),
-                                      (arrays["barrier_lo"][walls], arrays["barrier_hi"][walls]))
-            out.append(CheckResult(CLAIMS.name, str(name), KIND, True, f"{msg} ({time.perf_counter() - t0:.1f} s)"))
-        except Refused as exc:
-            out.append(CheckResult(CLAIMS.name, str(name), KIND, False, str(exc)))
+    with Workers(default_workers(), min_items=MIN_PART) as workers:
+        for j, claim in enumerate(doc["claims"]):
+            out.append(_one(geometry, j, claim, arrays, workers))
     return out
+
+
+def _one(geometry: Geometry, j: int, claim, arrays: dict, workers: Workers) -> CheckResult:
+    """The verdict on claim ``j`` of the file (its boxes: the npz rows tagged ``j``)."""
+    t0 = time.perf_counter()
+    name = str(claim.get("id", f"#{j}")) if isinstance(claim, dict) else f"#{j}"
+    try:
+        if not isinstance(claim, dict) or claim.get("region") != j:
+            raise Refused(f"claim {j}: expected an object whose region is {j}")
+        rows, walls = arrays["region_claim"] == j, arrays["barrier_claim"] == j
+        msg, _ = check_separation(geometry, claim, (arrays["region_lo"][rows], arrays["region_hi"][rows]),
+                                  (arrays["barrier_lo"][walls], arrays["barrier_hi"][walls]), workers)
+    except Refused as exc:
+        return CheckResult(CLAIMS.name, name, KIND, False, str(exc))
+    return CheckResult(CLAIMS.name, name, KIND, True, f"{msg} ({time.perf_counter() - t0:.1f} s)")
