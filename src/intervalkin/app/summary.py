@@ -200,7 +200,8 @@ def add_separation_bound(summary: dict) -> None:
     """Put the basic-region bound of the separations beside the certified one, when it is higher.
 
     Kept apart from ``lower`` (``separations_at_least``, and a sentence in ``why``): the library proves
-    it, but the separations are not in the certificates, so ``intervalkin verify`` does not re-prove it.
+    it, but the separations between cells with solutions are not in the certificates (only the count
+    barriers are), so ``intervalkin verify`` does not re-prove it.
     """
     sep = (summary.get("joint_cells") or {}).get("separations")
     block = summary["basic_regions"]
@@ -209,8 +210,9 @@ def add_separation_bound(summary: dict) -> None:
     n = sep["basic_regions_at_least"]
     block["separations_at_least"] = n
     block["why"] += (f"; the separations of cells of one signature (joint_cells.separations, "
-                     f"proofs/lemma-separation.md) prove at least {n}, but they are not yet in the "
-                     "certificates, so intervalkin verify does not re-prove that bound")
+                     f"proofs/lemma-separation.md) prove at least {n}, but those between cells with solutions rest "
+                     "on window patterns, not yet in the certificates (only count barriers are, "
+                     "joint_cells.separations.count_barriers), so intervalkin verify does not re-prove that bound")
 
 
 def add_barrier_certificates(summary: dict, claims: list[dict]) -> None:
