@@ -92,3 +92,15 @@ def test_count_barriers_are_reported_beside_the_separations():
     empty = {"joint_cells": {"separations": {"by_signature": []}}}
     add_barrier_certificates(empty, [])
     assert "count_barriers" not in empty["joint_cells"]["separations"]
+
+
+def test_the_report_says_which_separations_the_certificates_hold():
+    from intervalkin.app.report_joint import _barrier_text
+    from intervalkin.app.summary import add_barrier_certificates
+
+    summary = {"joint_cells": {"separations": {"by_signature": [{"signature": [0, 0, 0]}, {"signature": [2, 1, 1]}]}}}
+    sep = summary["joint_cells"]["separations"]
+    assert "not yet in the certificates" in _barrier_text(sep)
+    add_barrier_certificates(summary, [{"cell": 7, "signature": [0, 0, 0]}])
+    text = _barrier_text(sep)
+    assert "cells 7 from" in text and "at least 3 components" in text and "joint_separation.json" in text

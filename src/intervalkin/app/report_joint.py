@@ -13,6 +13,19 @@ __all__ = ["joint_cells_passage"]
 _FACE = 0.5  # a witness this close to a limit is said to lie "along" that face
 
 
+def _barrier_text(sep: dict) -> str:
+    """Which separations the certificates hold (count barriers) and which they do not."""
+    bars = sep.get("count_barriers")
+    if not bars:
+        return "These separations are not yet in the certificates, and the lower bound above does not use them."
+    cells = ", ".join(str(c) for row in bars["by_signature"] for c in row["cells"])
+    return (f"Those of cells {cells} from the other cells of their signature are also count barriers in "
+            "certificates/joint_separation.json, re-proved by intervalkin verify (proofs/lemma-count-barrier.md): "
+            f"at least {bars['all_components_at_least']} components of the joint box minus g(S) are certified. The "
+            "others rest on window patterns, are not yet in the certificates, and the lower bound above does not "
+            "use them.")
+
+
 def _where(witness: list[float], lo: list[float], hi: list[float]) -> str:
     near = [f"rho_{i + 1} = {lo[i]:g}" for i in range(3) if witness[i] - lo[i] < _FACE]
     near += [f"rho_{i + 1} = {hi[i]:g}" for i in range(3) if hi[i] - witness[i] < _FACE]
@@ -70,8 +83,7 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
             for g in apart)
             + f". Cells in different groups are proved to be different components (proofs/lemma-separation.md): "
             f"at least {sep['components_at_least']} components hold a cell, and at least "
-            f"{sep['basic_regions_at_least']} basic regions lie above them. These separations are not yet in the "
-            "certificates, and the lower bound above does not use them.\n")
+            f"{sep['basic_regions_at_least']} basic regions lie above them. " + _barrier_text(sep) + "\n")
     frags = jc.get("fragments") or []
     if frags:
         out.append(f"{len(frags)} fragment{'' if len(frags) == 1 else 's'} (certified islands inside the undecided layer, made only by the local "
