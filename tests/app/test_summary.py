@@ -103,4 +103,4 @@ def test_the_report_says_which_separations_the_certificates_hold():
     assert "not yet in the certificates" in _barrier_text(sep)
     add_barrier_certificates(summary, [{"cell": 7, "signature": [0, 0, 0]}])
     text = _barrier_text(sep)
-    assert "cells 7 from" in text and "at least 3 components" in text and "joint_separation.json" in text
+    assert "cell 7 from" in text and "at least 3 components" in text and "joint_separation.json" in text

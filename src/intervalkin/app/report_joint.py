@@ -18,8 +18,9 @@ def _barrier_text(sep: dict) -> str:
     bars = sep.get("count_barriers")
     if not bars:
         return "These separations are not yet in the certificates, and the lower bound above does not use them."
-    cells = ", ".join(str(c) for row in bars["by_signature"] for c in row["cells"])
-    return (f"Those of cells {cells} from the other cells of their signature are also count barriers in "
+    ids = [str(c) for row in bars["by_signature"] for c in row["cells"]]
+    return (f"The separations of cell{'s' if len(ids) > 1 else ''} {', '.join(ids)} from the other cells of their "
+            "signature are also count barriers in "
             "certificates/joint_separation.json, re-proved by intervalkin verify (proofs/lemma-count-barrier.md): "
             f"at least {bars['all_components_at_least']} components of the joint box minus g(S) are certified. The "
             "others rest on window patterns, are not yet in the certificates, and the lower bound above does not "
