@@ -120,13 +120,15 @@ def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET,
 
 
 def _grow(geometry: Geometry, p, a: np.ndarray, b: np.ndarray, region: np.ndarray, count: int,
-          forbidden: np.ndarray, budget: int, workers: Workers | None) -> tuple[tuple[np.ndarray, np.ndarray] | None, str]:
+          forbidden: np.ndarray, budget: int,
+          workers: Workers | None) -> tuple[tuple[np.ndarray, np.ndarray] | None, str]:
     """(region leaves, boundary contacts) once every boundary face excludes ``count``; or (None, why)."""
     region = region.copy()
     proved: dict[int, bool] = {}
     for _ in range(GROW_ROUNDS + 1):
         if region[forbidden].any():
-            return None, "its region reaches another cell of its signature (a finer paving, or the patterns of window models, would be needed)"
+            return None, ("its region reaches another cell of its signature (a finer paving, or the patterns of "
+                          "window models, would be needed)")
         edge = np.flatnonzero(region[a] ^ region[b])
         todo = np.array([e for e in edge.tolist() if e not in proved], dtype=np.int64)
         if len(proved) + todo.size > budget:

@@ -35,7 +35,8 @@ from intervalkin.recheck.arith import PI_HI, PI_LO, down, up
 from intervalkin.recheck.reduced_equation import ReducedConstants, d_sign, derivative_enclosures, reduced_constants, \
     sign_at_points
 
-__all__ = ["NO_BOUND", "PIECES", "DEPTH", "CountRanges", "count_ranges", "arc_ranges", "run_bounds", "r_box", "supported"]
+__all__ = ["NO_BOUND", "PIECES", "DEPTH", "HIGH_ORDER_LEVELS", "CountRanges", "count_ranges", "arc_ranges", "run_bounds",
+           "r_box", "supported"]
 
 #: ``hi`` of a box where some piece kept no proved bound.
 NO_BOUND = 99

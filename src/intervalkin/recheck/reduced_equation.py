@@ -44,7 +44,8 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.recheck.arith import Iv, add, const, cos_sin, down, fraction_enclosure, mul, sub, up
 from intervalkin.recheck.model import constants
 
-__all__ = ["ORDER", "ReducedConstants", "reduced_constants", "f_series", "derivative_enclosure", "derivative_enclosures", "sign_at_points", "d_sign"]
+__all__ = ["ORDER", "ReducedConstants", "reduced_constants", "f_series", "derivative_enclosure", "derivative_enclosures",
+           "sign_at_points", "d_sign"]
 
 #: Taylor coefficients kept: enough for the third derivative and its mean value form.
 ORDER = 4
@@ -165,8 +166,8 @@ def _combine(terms: tuple[Series, ...], r: tuple[Iv, Iv, Iv]) -> tuple[Series, l
     like = U[0][0]
     two = const(2.0, 2.0, like)
     s2, s3 = sub(r[1], r[0]), sub(r[2], r[0])
-    # df/ds_2 / 2 = s_2 U + s_3 W + P_2 and df/ds_3 / 2 = s_3 V + s_2 W + P_3; f = s_2 g_2 + s_3 g_3 + s_2 P_2
-    # + s_3 P_3 + P_0 - r_1 D^2 with g_i those halves minus P_i (the quadratic part counted once)
+    # h_i = (df/ds_i) / 2: h_2 = s_2 U + s_3 W + P_2, h_3 = s_3 V + s_2 W + P_3; then
+    # f = s_2 (h_2 - P_2) + s_3 (h_3 - P_3) + 2 s_2 P_2 + 2 s_3 P_3 + P_0 - r_1 D^2 (the quadratic part once)
     h2 = _s_add(_s_add(_s_scale(U, s2), _s_scale(W, s3)), P2)
     h3 = _s_add(_s_add(_s_scale(V, s3), _s_scale(W, s2)), P3)
     f = _s_add(_s_add(_s_scale(_s_sub(h2, P2), s2), _s_scale(_s_sub(h3, P3), s3)),

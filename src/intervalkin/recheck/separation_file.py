@@ -157,7 +157,8 @@ def check_separation(geometry: Geometry, claim: dict, region: tuple[np.ndarray, 
         if np.any(np.all((r_lo <= y_hi) & (y_lo <= r_hi), axis=1)):
             raise Refused(f"others[{k}]: its witness may lie in the region")
         cells.append(other.get("cell"))
-    free = count_ranges(geometry, b_lo, b_hi, workers=workers).excludes(sig[0]) if b_lo.size else np.zeros(0, dtype=bool)
+    free = (count_ranges(geometry, b_lo, b_hi, workers=workers).excludes(sig[0]) if b_lo.size
+            else np.zeros(0, dtype=bool))
     if not free.all():
         i = int(np.flatnonzero(~free)[0])
         raise Refused(f"{int((~free).sum())} barrier boxes not proved free of {sig[0]} solutions, the first "
