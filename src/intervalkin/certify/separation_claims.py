@@ -45,12 +45,19 @@ from intervalkin.solve.dkp import solve
 from intervalkin.space.joint_closure import piece_cells
 from intervalkin.space.joint_separation import ANY, possible_counts
 
-__all__ = ["GROW_ROUNDS", "FACE_BUDGET", "CountBarrier", "count_barriers", "separation_claims"]
+__all__ = ["GROW_ROUNDS", "FACE_BUDGET", "TOTAL_FACE_BUDGET", "SHRINK", "SAMPLE", "MAX_FAIL_SHARE",
+           "CountBarrier", "count_barriers", "separation_claims"]
 
 #: Rounds of moving failed faces outward before a region is given up.
 GROW_ROUNDS = 8
-#: Face rectangles tested per region at most (each costs a few milliseconds of count ranges).
-FACE_BUDGET = 30000
+#: Face rectangles tested per region at most, and for all regions of one paving (each costs about 1.5 ms of
+#: count ranges per core): the paper's three barriers test about 7000 in all, 4000 for the largest.
+FACE_BUDGET = 8000
+TOTAL_FACE_BUDGET = 20000
+#: A growth round must leave at most this share of the failed faces of the round before.
+SHRINK = 0.6
+#: Faces of a region's first boundary tested first, and the share of them that may fail.
+SAMPLE, MAX_FAIL_SHARE = 200, 0.35
 #: Faces worth sending to a second process at once.
 MIN_PART = 400
 
@@ -88,6 +95,7 @@ def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET,
     counts = possible_counts(jp)
     cells = piece_cells(jp)[0]
     barriers, omitted = [], []
+    total, spent = TOTAL_FACE_BUDGET, 0
     by_sig: dict[tuple, list] = {}
     for c in jp.cells:
         if c.signature[0] >= 0 and np.any(jp.cell == c.id):
@@ -105,8 +113,10 @@ def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET,
         order = sorted(mine, key=lambda c: size[c.id])
         for c in order[:-1]:
             others = [o for o in mine if o.id != c.id]
-            found, why = _grow(geometry, p, a, b, comp == comp[leaves[c.id][0]], count,
-                               np.concatenate([leaves[o.id] for o in others]), face_budget, workers)
+            found, why, used = _grow(geometry, p, a, b, comp == comp[leaves[c.id][0]], count,
+                                     np.concatenate([leaves[o.id] for o in others]),
+                                     min(face_budget, total - spent), workers)
+            spent += used
             if found is None:
                 omitted.append({"what": f"count barrier of cell {c.id} ({count} solutions)", "why": why})
                 continue
@@ -121,27 +131,46 @@ def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET,
 
 def _grow(geometry: Geometry, p, a: np.ndarray, b: np.ndarray, region: np.ndarray, count: int,
           forbidden: np.ndarray, budget: int,
-          workers: Workers | None) -> tuple[tuple[np.ndarray, np.ndarray] | None, str]:
-    """(region leaves, boundary contacts) once every boundary face excludes ``count``; or (None, why)."""
+          workers: Workers | None) -> tuple[tuple[np.ndarray, np.ndarray] | None, str, int]:
+    """(region leaves, boundary contacts) once every boundary face excludes ``count``, or None; why not; and the
+    number of faces tested (at most ``budget``).  Growth stops when a round leaves more than
+    :data:`SHRINK` times the failed faces of the round before: the barrier is then not moving away from g(S)
+    but along it (two cells of the count meeting at a crossing of two sheets)."""
     region = region.copy()
     proved: dict[int, bool] = {}
-    for _ in range(GROW_ROUNDS + 1):
+    before = None
+    for k in range(GROW_ROUNDS + 1):
         if region[forbidden].any():
             return None, ("its region reaches another cell of its signature (a finer paving, or the patterns of "
-                          "window models, would be needed)")
+                          "window models, would be needed)"), len(proved)
         edge = np.flatnonzero(region[a] ^ region[b])
         todo = np.array([e for e in edge.tolist() if e not in proved], dtype=np.int64)
         if len(proved) + todo.size > budget:
-            return None, f"more than {budget} faces to test"
+            return None, f"more than {budget} faces to test", len(proved)
+        if k == 0 and todo.size > 2 * SAMPLE:
+            # an even sample of the first boundary first: a region whose barrier is far from closing is given up cheaply
+            pick = todo[np.linspace(0, todo.size - 1, SAMPLE).astype(np.int64)]
+            lo = np.maximum(p.lo[a[pick]], p.lo[b[pick]])
+            hi = np.minimum(p.hi[a[pick]], p.hi[b[pick]])
+            ok = count_ranges(geometry, lo, hi, workers=workers).excludes(count)
+            proved.update(zip(pick.tolist(), ok.tolist()))
+            if (~ok).mean() > MAX_FAIL_SHARE:
+                return None, (f"{(~ok).mean():.0%} of a sample of its boundary faces hold points of {count} solutions "
+                              "or are not decided"), len(proved)
+            todo = np.array([e for e in todo.tolist() if e not in proved], dtype=np.int64)
         if todo.size:
             lo = np.maximum(p.lo[a[todo]], p.lo[b[todo]])
             hi = np.minimum(p.hi[a[todo]], p.hi[b[todo]])
             proved.update(zip(todo.tolist(), count_ranges(geometry, lo, hi, workers=workers).excludes(count).tolist()))
         fail = np.array([e for e in edge.tolist() if not proved[e]], dtype=np.int64)
         if fail.size == 0:
-            return (np.flatnonzero(region), edge), ""
+            return (np.flatnonzero(region), edge), "", len(proved)
+        if before is not None and fail.size > SHRINK * before:
+            return None, (f"faces with {count} solutions not excluded: {before} then {fail.size} after round {k} "
+                          "(the barrier runs along g(S), not away from it)"), len(proved)
+        before = fail.size
         region[np.where(region[a[fail]], b[fail], a[fail])] = True
-    return None, f"faces with {count} solutions not excluded after {GROW_ROUNDS} rounds"
+    return None, f"faces with {count} solutions not excluded after {GROW_ROUNDS} rounds", len(proved)
 
 
 def _end(geometry: Geometry, q, precision: int) -> tuple[dict | None, str]:
