@@ -36,14 +36,14 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import breadth_first_order
 
-from intervalkin.certify.evidence import box_json, certified
+from intervalkin.certify.evidence import box_json
+from intervalkin.certify.solve_claims import witness_end
 from intervalkin.checker.claims import MALFORMED, run_check
 from intervalkin.checker.joint_join import MODEL_FILE
 from intervalkin.checker.parse import Refused
 from intervalkin.core.exact import exact_text
 from intervalkin.core.geometry import Geometry
 from intervalkin.paving.adjacency import component_labels, shares_face
-from intervalkin.solve.dkp import solve
 from intervalkin.solve.fold_model import side_of
 
 __all__ = ["MAX_JOINS", "MAX_MODELS", "joint_claims"]
@@ -181,20 +181,7 @@ class _Writer:
 
     # --- joins ------------------------------------------------------------------------
     def _end(self, q) -> tuple[dict | None, str]:
-        q = tuple(Fraction(v) for v in q)
-        res = solve(self.geometry, q)
-        sols = [{"box": box_json(s.box), "det_sign": int(s.det_sign)}
-                for s in res.solutions if s.status == "unique" and s.det_sign != 0]
-        if not res.complete or len(sols) != len(res.solutions):
-            return None, f"the solve at {_point(q)} is not complete"
-        n1 = sum(1 for s in sols if s["det_sign"] > 0)
-        claim = {"id": "end", "witness": _point(q), "count": len(sols), "n_wa1": n1, "n_wa2": len(sols) - n1,
-                 "phi0": 0.0, "solutions": sols}
-        got, why = certified(self.geometry, "joint_cell", claim, max(self.precision, res.precision))
-        if got is None:
-            return None, why
-        del got["id"]
-        return got, ""
+        return witness_end(self.geometry, q, self.precision)
 
     def _link(self, a: int, b: int, side: dict) -> np.ndarray | None:
         """A point of the face shared by original nodes a and b, placed on the stated side of each fold end."""

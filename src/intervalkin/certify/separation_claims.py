@@ -35,13 +35,11 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from intervalkin.certify.evidence import box_json, certified
-from intervalkin.core.exact import exact_text
+from intervalkin.certify.solve_claims import witness_end
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers, default_workers
 from intervalkin.paving.adjacency import shares_face
 from intervalkin.recheck.count_range import count_ranges, supported
-from intervalkin.solve.dkp import solve
 from intervalkin.space.joint_closure import piece_cells
 from intervalkin.space.joint_separation import ANY, possible_counts
 
@@ -173,23 +171,6 @@ def _grow(geometry: Geometry, p, a: np.ndarray, b: np.ndarray, region: np.ndarra
     return None, f"faces with {count} solutions not excluded after {GROW_ROUNDS} rounds", len(proved)
 
 
-def _end(geometry: Geometry, q, precision: int) -> tuple[dict | None, str]:
-    """A witness with its complete, checker-verified solution list (a ``joint_cell``-shaped object)."""
-    res = solve(geometry, q)
-    sols = [{"box": box_json(s.box), "det_sign": int(s.det_sign)}
-            for s in res.solutions if s.status == "unique" and s.det_sign != 0]
-    if not res.complete or len(sols) != len(res.solutions):
-        return None, "the solve of a witness is not complete"
-    n1 = sum(1 for s in sols if s["det_sign"] > 0)
-    claim = {"id": "end", "witness": [exact_text(v) for v in q], "count": len(sols), "n_wa1": n1,
-             "n_wa2": len(sols) - n1, "phi0": 0.0, "solutions": sols}
-    got, why = certified(geometry, "joint_cell", claim, max(precision, res.precision))
-    if got is None:
-        return None, why
-    del got["id"]
-    return got, ""
-
-
 def separation_claims(geometry: Geometry, jp, precision: int = 128) -> tuple[list[dict], dict, list[dict]]:
     """(claims, npz arrays, omitted) of ``certificates/joint_separation.json`` and ``.npz``.
 
@@ -201,7 +182,7 @@ def separation_claims(geometry: Geometry, jp, precision: int = 128) -> tuple[lis
     claims: list[dict] = []
     arrays = {k: [] for k in ("region_lo", "region_hi", "region_claim", "barrier_lo", "barrier_hi", "barrier_claim")}
     for bar in barriers:
-        ends = [_end(geometry, q, precision) for q in (bar.witness, *bar.other_witnesses)]
+        ends = [witness_end(geometry, q, precision) for q in (bar.witness, *bar.other_witnesses)]
         bad = next((why for got, why in ends if got is None), None)
         if bad is not None:
             omitted.append({"what": f"count barrier of cell {bar.cell}", "why": bad})

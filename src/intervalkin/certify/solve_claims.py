@@ -19,6 +19,7 @@ writer lists it under ``omitted``.
 
 from __future__ import annotations
 
+from fractions import Fraction
 from typing import Sequence
 
 from intervalkin.certify.evidence import box_json, certified, rho_text
@@ -26,13 +27,32 @@ from intervalkin.core.exact import exact_text
 from intervalkin.core.geometry import Geometry
 from intervalkin.solve.dkp import solve
 
-__all__ = ['dkp_claim', 'joint_cell_claims', 'trajectory_claims']
+__all__ = ['dkp_claim', 'joint_cell_claims', 'trajectory_claims', 'witness_end']
 
 
 def _solution_entries(solutions) -> list[dict]:
     """The unique solutions with a proved det A sign, as claim entries."""
     return [{"box": box_json(s.box), "det_sign": int(s.det_sign)}
             for s in solutions if s.status == "unique" and s.det_sign != 0]
+
+
+def witness_end(geometry: Geometry, q, precision: int = 128) -> tuple[dict | None, str]:
+    """A joint vector with its complete, checker-verified solution list, count and aspect split (the object a
+    ``joint_join`` end or a count barrier's witness is), or (None, why not)."""
+    q = tuple(Fraction(v) for v in q)
+    point = [exact_text(v) for v in q]
+    res = solve(geometry, q)
+    sols = _solution_entries(res.solutions)
+    if not res.complete or len(sols) != len(res.solutions):
+        return None, f"the solve at {point} is not complete"
+    n1 = sum(1 for s in sols if s["det_sign"] > 0)
+    claim = {"id": "end", "witness": point, "count": len(sols), "n_wa1": n1,
+             "n_wa2": len(sols) - n1, "phi0": 0.0, "solutions": sols}
+    got, why = certified(geometry, "joint_cell", claim, max(precision, res.precision))
+    if got is None:
+        return None, why
+    del got["id"]
+    return got, ""
 
 
 def dkp_claim(geometry: Geometry, result, claim_id: str, precision: int = 128) -> tuple[dict | None, str]:

@@ -223,9 +223,8 @@ def count_ranges(geometry: Geometry, q_lo: np.ndarray, q_hi: np.ndarray, pieces:
     q_lo, q_hi = np.atleast_2d(q_lo), np.atleast_2d(q_hi)
     r_box(q_lo, q_hi)  # validates every box before any part is sent away
     n = q_lo.shape[0]
-    parts = [(0, n)] if workers is None else workers.parts(n)
-    got = (workers.run if workers is not None else lambda fn, calls: [fn(*c) for c in calls])(
-        _ranges_part, [(geometry, q_lo[a:b], q_hi[a:b], pieces, depth) for a, b in parts])
+    workers = workers or Workers(1)  # one process: the single part is computed here
+    got = workers.run(_ranges_part, [(geometry, q_lo[a:b], q_hi[a:b], pieces, depth) for a, b in workers.parts(n)])
     if not got:
         return CountRanges(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
     return CountRanges(np.concatenate([g[0] for g in got]), np.concatenate([g[1] for g in got]))
