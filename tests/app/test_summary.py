@@ -82,13 +82,17 @@ def test_count_barriers_are_reported_beside_the_separations():
 
     summary = {"joint_cells": {"separations": {"by_signature": [
         {"signature": [0, 0, 0]}, {"signature": [2, 1, 1]}, {"signature": [4, 2, 2]}]}}}
+    summary["basic_regions"] = {"lower_bound": 6, "why": "Theorem 1"}
     claims = [{"cell": 7, "signature": [0, 0, 0]}, {"cell": 6, "signature": [0, 0, 0]},
-              {"cell": 3, "signature": [4, 2, 2]}]
+              {"cell": 3, "signature": [4, 2, 2], "kind": "pattern"}]
     add_barrier_certificates(summary, claims)
     got = summary["joint_cells"]["separations"]["count_barriers"]
     assert [r["components_at_least"] for r in got["by_signature"]] == [3, 2]
     assert got["components_at_least"] == 5 and got["all_components_at_least"] == 3 + 1 + 2
-    assert got["basic_regions_at_least"] == 2 * 4
+    # 2 components of 4 solutions, 1 of 2: Theorem 1 puts 2 * 4 + 1 * 2 basic regions above them
+    assert got["basic_regions_at_least"] == 2 * 4 + 2
+    assert got["pattern_barrier_cells"] == [3] and got["count_barrier_cells"] == [6, 7]
+    assert summary["basic_regions"]["barriers_at_least"] == 10 and "re-proved by" in summary["basic_regions"]["why"]
     empty = {"joint_cells": {"separations": {"by_signature": []}}}
     add_barrier_certificates(empty, [])
     assert "count_barriers" not in empty["joint_cells"]["separations"]

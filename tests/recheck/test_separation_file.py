@@ -1,8 +1,9 @@
-"""Count barriers: built on a joint paving of the paper's manipulator, re-proved from the files, and refused
-when the files are made false.
+"""Count and pattern barriers: built on a joint paving of the paper's manipulator, re-proved from the files,
+and refused when the files are made false.
 
 The paving is the depth-5 paving with window models of ``tests/conftest.py`` (``fold_paving``).  Every
-mutation below breaks exactly one hypothesis of proofs/lemma-count-barrier.md and must be refused.
+mutation below breaks exactly one hypothesis of proofs/lemma-count-barrier.md or
+proofs/lemma-pattern-barrier.md and must be refused.
 """
 
 from __future__ import annotations
@@ -17,14 +18,46 @@ from intervalkin.certify.separation_claims import separation_claims
 from intervalkin.checker.parse import Refused
 from intervalkin.core.errors import CertificateFormatError
 from intervalkin.core.files import write_json
-from intervalkin.recheck.separation_file import ARRAYS, CLAIMS, check_separation, recheck_separations
+from intervalkin.recheck.arc_pattern import box_arcs, pattern_of_angles, unpack
+from intervalkin.recheck.reduced_equation import reduced_constants
+from intervalkin.recheck.separation_file import ARRAYS, CLAIMS, check_pattern_separation, check_separation, \
+    recheck_separations
 from intervalkin.solve.dkp import solve
 
 
 @pytest.fixture(scope="module")
-def built(fold_paving, paper_geometry):
-    claims, arrays, omitted = separation_claims(paper_geometry, fold_paving)
-    return claims, arrays, omitted
+def every(fold_paving, paper_geometry):
+    return separation_claims(paper_geometry, fold_paving)
+
+
+@pytest.fixture(scope="module")
+def built(every):
+    """The count barriers (the first claims of the file)."""
+    claims, arrays, omitted = every
+    return [c for c in claims if c.get("kind", "count") == "count"], arrays, omitted
+
+
+def _pattern_parts(arrays, j):
+    """(region, patterns per region box, barrier, barrier's region box (local), outer boxes) of claim j."""
+    rows = arrays["region_claim"] == j
+    index = np.flatnonzero(rows)
+    local = np.full(rows.size, -1)
+    local[index] = np.arange(index.size)
+    walls = arrays["barrier_claim"] == j
+    patterns = [set() for _ in index]
+    mine = rows[arrays["pattern_box"]]
+    for r, pat in zip(local[arrays["pattern_box"][mine]], unpack(arrays["pattern_rows"][mine])):
+        patterns[r].add(pat)
+    return ((arrays["region_lo"][rows], arrays["region_hi"][rows]), patterns,
+            (arrays["barrier_lo"][walls], arrays["barrier_hi"][walls]), local[arrays["barrier_box"][walls]],
+            (arrays["barrier_outer_lo"][walls], arrays["barrier_outer_hi"][walls]))
+
+
+@pytest.fixture(scope="module")
+def patterned(every):
+    claims, arrays, _ = every
+    j = next(j for j, c in enumerate(claims) if c.get("kind") == "pattern")
+    return claims[j], _pattern_parts(arrays, j)
 
 
 def _parts(arrays, j):
@@ -34,8 +67,8 @@ def _parts(arrays, j):
 
 def test_the_barriers_of_the_paper_paving_verify(built, paper_geometry):
     claims, arrays, omitted = built
-    # the four cells without solutions: three barriers tell them all apart; the cells with solutions meet at
-    # transversal crossings of two sheets, where only the patterns of window models tell them apart
+    # the four cells without solutions: three count barriers tell them all apart; the cells with solutions meet
+    # at transversal crossings of two sheets, where only the patterns of their solutions tell them apart
     assert len(claims) == 3 and {c["signature"][0] for c in claims} == {0}
     assert any("another cell of its signature" in o["why"] for o in omitted)
     rng = np.random.default_rng(5)
@@ -101,12 +134,76 @@ def test_a_false_signature_is_refused(built, paper_geometry):
         check_separation(paper_geometry, dict(claims[0], signature=[2, 1, 1]), region, barrier)
 
 
+def test_the_pattern_barrier_verifies(patterned, paper_geometry):
+    """The cell with 2 solutions next to the big one (they meet where two sheets cross) has a pattern barrier;
+    sampled on its barrier faces, the solver's solutions never show a pattern of the region box's set."""
+    claim, (region, patterns, barrier, box, outer) = patterned
+    assert claim["signature"][0] == 2
+    msg, facts = check_pattern_separation(paper_geometry, claim, region, patterns, barrier, box, outer)
+    assert facts["cell"] == claim["cell"] and "shared faces related" in msg
+    k = reduced_constants(paper_geometry)
+    arcs = box_arcs(k, *region)
+    rng = np.random.default_rng(7)
+    seen = 0
+    for t in rng.choice(len(barrier[0]), 150, replace=False):
+        q = rng.uniform(barrier[0][t], barrier[1][t])
+        res = solve(paper_geometry, tuple(Fraction(float(v)) for v in q))
+        if not res.complete or len(res.solutions) != 2:
+            continue
+        phi = np.array([s.box[2][0] for s in res.solutions]), np.array([s.box[2][1] for s in res.solutions])
+        assert pattern_of_angles(arcs.signs[box[t]], *phi) not in patterns[box[t]]
+        seen += 1
+    assert seen > 5  # the faces do hold points of the count: only the patterns tell them apart
+
+
+def test_a_pattern_barrier_without_a_face_is_refused(patterned, paper_geometry):
+    claim, (region, patterns, barrier, box, outer) = patterned
+    cut = lambda v: (v[0][1:], v[1][1:])  # noqa: E731
+    with pytest.raises(Refused, match="lie on no barrier box"):
+        check_pattern_separation(paper_geometry, claim, region, patterns, cut(barrier), box[1:], cut(outer))
+
+
+def test_a_pattern_dropped_from_a_box_is_refused(patterned, paper_geometry):
+    """Emptying the set of a box inside the region breaks the consistency on its faces (or the witness)."""
+    claim, (region, patterns, barrier, box, outer) = patterned
+    inner = [i for i in range(len(patterns)) if i not in set(box.tolist()) and patterns[i]]
+    changed = list(patterns)
+    changed[inner[len(inner) // 2]] = set()
+    with pytest.raises(Refused, match="shared face|witness"):
+        check_pattern_separation(paper_geometry, claim, region, changed, barrier, box, outer)
+
+
+def test_the_other_pattern_added_is_refused(patterned, paper_geometry):
+    """A barrier box's region box given every pattern its face relation allows is no longer walled off."""
+    claim, (region, patterns, barrier, box, outer) = patterned
+    k = reduced_constants(paper_geometry)
+    from intervalkin.recheck.arc_pattern import face_relations
+    arcs = box_arcs(k, *region)
+    rels = face_relations(k, barrier[0], barrier[1], arcs.take(box), box_arcs(k, *outer), claim["signature"][0])
+    t = next(t for t, rel in enumerate(rels) if rel)  # a barrier face that may hold points of the count
+    changed = list(patterns)
+    changed[box[t]] = set(patterns[box[t]]) | {u for u, _ in rels[t]}
+    with pytest.raises(Refused):
+        check_pattern_separation(paper_geometry, claim, region, changed, barrier, box, outer)
+
+
+def test_a_swapped_pattern_witness_is_refused(patterned, paper_geometry):
+    claim, (region, patterns, barrier, box, outer) = patterned
+    swapped = dict(claim, witness=claim["others"][0], others=[claim["witness"]])
+    with pytest.raises(Refused, match="witness"):
+        check_pattern_separation(paper_geometry, swapped, region, patterns, barrier, box, outer)
+
+
 def test_the_folder_is_read_and_a_corrupt_file_is_a_format_error(built, paper_geometry, tmp_path):
     claims, arrays, _ = built
     cert = tmp_path / "certificates"
     write_json(cert / "index.json", {"geometry_toml": paper_geometry.to_toml()})
     write_json(tmp_path / CLAIMS, {"claims": claims[:1]})
     keep = {k: v for k, v in arrays.items()}
+    walls = keep["barrier_claim"] == 0
+    for k in ("barrier_box", "barrier_outer_lo", "barrier_outer_hi"):
+        keep[k] = keep[k][walls]
+    keep["pattern_box"], keep["pattern_rows"] = keep["pattern_box"][:0], keep["pattern_rows"][:0]
     for name in ("region", "barrier"):
         rows = keep[f"{name}_claim"] == 0
         for col in ("lo", "hi", "claim"):

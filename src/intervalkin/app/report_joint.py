@@ -19,12 +19,15 @@ def _barrier_text(sep: dict) -> str:
     if not bars:
         return "These separations are not yet in the certificates, and the lower bound above does not use them."
     ids = [str(c) for row in bars["by_signature"] for c in row["cells"]]
+    pattern = bars.get("pattern_barrier_cells") or []
     return (f"The separations of cell{'s' if len(ids) > 1 else ''} {', '.join(ids)} from the other cells of their "
-            "signature are also count barriers in "
-            "certificates/joint_separation.json, re-proved by intervalkin verify (proofs/lemma-count-barrier.md): "
-            f"at least {bars['all_components_at_least']} components of the joint box minus g(S) are certified. The "
-            "others rest on window patterns, are not yet in the certificates, and the lower bound above does not "
-            "use them.")
+            "signature are also in certificates/joint_separation.json, re-proved by intervalkin verify: count "
+            "barriers (proofs/lemma-count-barrier.md)"
+            + (f" and, for cell{'s' if len(pattern) > 1 else ''} {', '.join(map(str, pattern))}, a pattern barrier "
+               "(proofs/lemma-pattern-barrier.md)" if pattern else "")
+            + f": at least {bars['all_components_at_least']} components of the joint box minus g(S) and "
+            f"{bars['basic_regions_at_least']} basic regions are certified. The others rest on window patterns "
+            "and are not yet in the certificates.")
 
 
 def _where(witness: list[float], lo: list[float], hi: list[float]) -> str:

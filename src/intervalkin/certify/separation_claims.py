@@ -35,15 +35,19 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from intervalkin.certify.pattern_barriers import PatternBarrier, centre, flood, merged_paving, solution_pattern
 from intervalkin.certify.solve_claims import witness_end
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers, default_workers
 from intervalkin.paving.adjacency import shares_face
+from intervalkin.paving.tree import box_bounds
+from intervalkin.recheck.arc_pattern import MAX_COUNT, box_arcs, pack
 from intervalkin.recheck.count_range import count_ranges, supported
+from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.space.joint_closure import piece_cells
 from intervalkin.space.joint_separation import ANY, possible_counts
 
-__all__ = ["GROW_ROUNDS", "FACE_BUDGET", "TOTAL_FACE_BUDGET", "SHRINK", "SAMPLE", "MAX_FAIL_SHARE",
+__all__ = ["PATTERN_BUDGET", "pattern_barriers", "GROW_ROUNDS", "FACE_BUDGET", "TOTAL_FACE_BUDGET", "SHRINK", "SAMPLE", "MAX_FAIL_SHARE",
            "CountBarrier", "count_barriers", "separation_claims"]
 
 #: Rounds of moving failed faces outward before a region is given up.
@@ -58,6 +62,14 @@ SHRINK = 0.6
 SAMPLE, MAX_FAIL_SHARE = 200, 0.35
 #: Faces worth sending to a second process at once.
 MIN_PART = 400
+#: Faces a pattern barrier's flood may relate, and all of one paving's floods (about 2 ms each).
+PATTERN_BUDGET, TOTAL_PATTERN_BUDGET = 8000, 16000
+#: Faces a region box brings to its flood, about (a box has six faces, each shared by two boxes, and more small
+#: neighbours where the paving is finer).
+FACES_PER_BOX = 6
+#: The npz columns of ``certificates/joint_separation.npz``.
+_COLUMNS = ("region_lo", "region_hi", "region_claim", "barrier_lo", "barrier_hi", "barrier_claim", "barrier_box",
+            "barrier_outer_lo", "barrier_outer_hi", "pattern_box", "pattern_rows")
 
 
 @dataclass(frozen=True)
@@ -171,16 +183,101 @@ def _grow(geometry: Geometry, p, a: np.ndarray, b: np.ndarray, region: np.ndarra
     return None, f"faces with {count} solutions not excluded after {GROW_ROUNDS} rounds", len(proved)
 
 
+def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
+                     budget: int = PATTERN_BUDGET) -> tuple[list[tuple[dict, list[dict], PatternBarrier]], list[dict]]:
+    """Pattern barriers (:mod:`intervalkin.certify.pattern_barriers`) for the cells with solutions whose signature
+    two cells or more share: for a signature with k cells, barriers are tried cell by cell until k - 1 are found
+    (enough to tell every pair apart).  Returns (witness, other witnesses (with ``cell``), barrier) per barrier
+    and what was left out."""
+    p = jp.paving
+    out, omitted = [], []
+    if not supported(geometry):
+        return out, omitted
+    by_sig: dict[tuple, list] = {}
+    for c in jp.cells:
+        if c.signature[0] > 0 and np.any(jp.cell == c.id):
+            by_sig.setdefault(c.signature, []).append(c)
+    groups = [(sig, mine) for sig, mine in sorted(by_sig.items()) if len(mine) > 1]
+    if not groups:
+        return out, omitted
+    # the flood runs on the paving with sibling clear leaves of one cell merged (fewer, larger boxes)
+    level, ijk, _, owner = merged_paving(p.level, p.ijk, jp.cell)
+    lo, hi = box_bounds(p.domain, level, ijk)
+    a, b = shares_face(level, ijk, int(level.max()), periodic=(False, False, False))
+    k = reduced_constants(geometry)
+    spent = 0
+    for sig, mine in groups:
+        leaf = {c.id: int(np.flatnonzero(jp.cell == c.id)[0]) for c in mine}  # a clear leaf: its centre is inside
+        node = {cid: int(owner[x]) for cid, x in leaf.items()}
+        ends, pats = {}, {}
+        arcs = box_arcs(k, lo[list(node.values())], hi[list(node.values())])
+        for i, c in enumerate(mine):
+            got, why = witness_end(geometry, centre(p.lo, p.hi, leaf[c.id]), precision)
+            if got is None or (got["count"], got["n_wa1"], got["n_wa2"]) != tuple(sig):
+                omitted.append({"what": f"pattern barrier of cell {c.id}", "why": why or "its witness's signature differs"})
+                continue
+            ends[c.id], pats[c.id] = got, solution_pattern(arcs, i, got)
+        # the smallest cells first: a region holds its whole cell, and k - 1 barriers tell k cells apart
+        boxes = {c.id: np.unique(owner[jp.cell == c.id]).size for c in mine}
+        ready = sorted((c for c in mine if pats.get(c.id) is not None), key=lambda c: boxes[c.id])
+        made = 0
+        for c in ready:
+            if made == len(mine) - 1 or spent >= TOTAL_PATTERN_BUDGET:
+                break
+            others = [o for o in mine if o.id != c.id]
+            if any(o.id not in ends or pats[o.id] is None for o in others):
+                omitted.append({"what": f"pattern barrier of cell {c.id}", "why": "another cell's witness has no pattern"})
+                continue
+            if boxes[c.id] * FACES_PER_BOX > min(budget, TOTAL_PATTERN_BUDGET - spent):
+                # the region holds the whole cell, and each box brings about FACES_PER_BOX faces: it cannot close
+                omitted.append({"what": f"pattern barrier of cell {c.id} ({sig[0]} solutions)",
+                                "why": f"the cell alone is {boxes[c.id]} boxes of the paving, past the face budget"})
+                continue
+            forbidden = {node[o.id]: {pats[o.id]} for o in others}
+            rivals = np.unique(owner[np.isin(jp.cell, [o.id for o in others])])
+            bar, why, used = flood(geometry, lo, hi, a, b, sig[0], (node[c.id], pats[c.id]), forbidden, rivals,
+                                   budget=min(budget, TOTAL_PATTERN_BUDGET - spent))
+            spent += used
+            if bar is None:
+                omitted.append({"what": f"pattern barrier of cell {c.id} ({sig[0]} solutions)", "why": why})
+                continue
+            made += 1
+            out.append((ends[c.id], [dict(ends[o.id], cell=int(o.id)) for o in others], bar, c.id, tuple(sig)))
+    return out, omitted
+
+
 def separation_claims(geometry: Geometry, jp, precision: int = 128) -> tuple[list[dict], dict, list[dict]]:
     """(claims, npz arrays, omitted) of ``certificates/joint_separation.json`` and ``.npz``.
 
     Claim j: ``cell``, ``signature``, ``witness`` and ``others`` (each a witness object with its
     complete solution list, as in a ``joint_cell`` claim, plus ``cell``), ``region`` (j itself: the
-    rows of the npz whose ``region_claim`` / ``barrier_claim`` is j)."""
+    rows of the npz whose ``region_claim`` / ``barrier_claim`` is j).  A count barrier's barrier rows
+    have ``barrier_box`` -1; a pattern barrier (``"kind": "pattern"``) ties each barrier row to the region
+    row it lies on (``barrier_box``, an index into all region rows) and to the box beyond it
+    (``barrier_outer_lo`` / ``_hi``), and lists the pattern set of each region row (``pattern_box``, rows of
+    ``pattern_rows``: sorted arc starts padded with -2)."""
     with Workers(default_workers(), min_items=MIN_PART) as workers:
         barriers, omitted = count_barriers(jp, geometry, workers=workers)
+    patterned, left = pattern_barriers(jp, geometry, precision)
+    omitted += left
     claims: list[dict] = []
-    arrays = {k: [] for k in ("region_lo", "region_hi", "region_claim", "barrier_lo", "barrier_hi", "barrier_claim")}
+    arrays = {k: [] for k in _COLUMNS}
+    rows = 0
+
+    def add(region, barrier, box, outer, patterns, j):
+        nonlocal rows
+        for name, value in (("region", region), ("barrier", barrier)):
+            arrays[f"{name}_lo"].append(value[0])
+            arrays[f"{name}_hi"].append(value[1])
+            arrays[f"{name}_claim"].append(np.full(len(value[0]), j, dtype=np.int64))
+        arrays["barrier_box"].append(np.where(box >= 0, box + rows, -1).astype(np.int64))
+        arrays["barrier_outer_lo"].append(outer[0])
+        arrays["barrier_outer_hi"].append(outer[1])
+        for i, pats in enumerate(patterns):
+            arrays["pattern_box"].append(np.full(len(pats), rows + i, dtype=np.int64))
+            arrays["pattern_rows"].append(pack(list(pats)))
+        rows += len(region[0])
+
     for bar in barriers:
         ends = [witness_end(geometry, q, precision) for q in (bar.witness, *bar.other_witnesses)]
         bad = next((why for got, why in ends if got is None), None)
@@ -204,13 +301,31 @@ def separation_claims(geometry: Geometry, jp, precision: int = 128) -> tuple[lis
                           f"boundary is covered by {len(bar.barrier_lo)} face rectangles with no point of "
                           f"{bar.signature[0]} solutions"),
         })
-        for name, value in (("region", (bar.region_lo, bar.region_hi)), ("barrier", (bar.barrier_lo, bar.barrier_hi))):
-            arrays[f"{name}_lo"].append(value[0])
-            arrays[f"{name}_hi"].append(value[1])
-            arrays[f"{name}_claim"].append(np.full(len(value[0]), j, dtype=np.int64))
-    out = {k: (np.concatenate(v) if v else np.zeros((0, 3) if not k.endswith("claim") else 0))
+        add((bar.region_lo, bar.region_hi), (bar.barrier_lo, bar.barrier_hi), np.full(len(bar.barrier_lo), -1),
+            (bar.barrier_lo, bar.barrier_hi), [], j)
+    for witness, others, bar, cell, sig in patterned:
+        j = len(claims)
+        claims.append({
+            "id": f"cell-{cell}",
+            "kind": "pattern",
+            "cell": int(cell),
+            "signature": list(sig),
+            "witness": witness,
+            "others": others,
+            "region": j,
+            "statement": (f"joint cell {cell} ({sig[0]} solutions, {sig[1]} in WA1) lies in another component of the "
+                          f"joint box minus g(S) than cells {', '.join(str(o['cell']) for o in others)}: "
+                          f"{len(bar.region_lo)} boxes around its witness with the patterns its solutions may take "
+                          f"there, whose boundary is covered by {len(bar.barrier_lo)} face rectangles where none of "
+                          "those patterns occurs"),
+        })
+        add((bar.region_lo, bar.region_hi), (bar.barrier_lo, bar.barrier_hi), bar.barrier_box,
+            (bar.outer_lo, bar.outer_hi), bar.patterns, j)
+    shapes = {"pattern_rows": (0, MAX_COUNT)}
+    out = {k: (np.concatenate(v) if v else np.zeros(shapes.get(k, (0, 3) if k.endswith(("lo", "hi")) else 0)))
            for k, v in arrays.items()}
     for k in out:
-        if k.endswith("claim"):
+        if k.endswith(("claim", "box")):
             out[k] = out[k].astype(np.int64)
+    out["pattern_rows"] = out["pattern_rows"].astype(np.int16)
     return claims, out, omitted

@@ -110,13 +110,23 @@ def _pieces(k: ReducedConstants, r_lo, r_hi, box, a, b, pieces: int, depth: int)
         # the seam's enclosure keeps the arc ends at +-pi inside the interval
         plo = np.where(lo_phi <= -PI_LO, -PI_HI, lo_phi)
         phi_ = np.where(hi_phi >= PI_LO, PI_HI, hi_phi)
-        enc = derivative_enclosures(k, r_lo[b_of], r_hi[b_of], plo, phi_)
         order = np.full(owner.size, -1)
         sign = np.zeros(owner.size, dtype=np.int8)
-        for d in range(len(enc) - 1, -1, -1):
-            pos, neg = enc[d][0] > 0, enc[d][1] < 0
-            order = np.where(pos | neg, d, order)
-            sign = np.where(pos, 1, np.where(neg, -1, sign)).astype(np.int8)
+        # f itself first, from the first two Taylor coefficients only (most pieces hold no root); the same
+        # enclosure of f as the full call would give, since truncation leaves the kept coefficients as they are
+        f0 = derivative_enclosures(k, r_lo[b_of], r_hi[b_of], plo, phi_, 1)[0]
+        pos, neg = f0[0] > 0, f0[1] < 0
+        order[pos | neg] = 0
+        sign[pos], sign[neg] = 1, -1
+        more = np.flatnonzero(~(pos | neg))
+        if more.size:
+            enc = derivative_enclosures(k, r_lo[b_of[more]], r_hi[b_of[more]], plo[more], phi_[more])
+            o, sg = order[more], sign[more]
+            for d in range(len(enc) - 1, 0, -1):
+                pos, neg = enc[d][0] > 0, enc[d][1] < 0
+                o = np.where(pos | neg, d, o)
+                sg = np.where(pos, 1, np.where(neg, -1, sg)).astype(np.int8)
+            order[more], sign[more] = o, sg
         # a piece where only the second or third derivative has a sign may hold no root, or one: halve it while
         # the depth allows, so that Rolle's bound of 2 or 3 is only paid where the roots are close together
         done = (order >= 0) & ((order <= 1) | (level >= depth - HIGH_ORDER_LEVELS))

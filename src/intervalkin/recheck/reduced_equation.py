@@ -101,7 +101,7 @@ def _s_scale(a: Series, c: Iv) -> Series:
 
 def _s_mul(a: Series, b: Series) -> Series:
     out = []
-    for j in range(ORDER + 1):
+    for j in range(min(len(a), len(b))):
         acc = mul(a[0], b[j])
         for i in range(1, j + 1):
             acc = add(acc, mul(a[i], b[j - i]))
@@ -109,49 +109,50 @@ def _s_mul(a: Series, b: Series) -> Series:
     return out
 
 
-def _s_const(c: Iv) -> Series:
-    return [c] + [_zero(c[0]) for _ in range(ORDER)]
+def _s_const(c: Iv, n: int = ORDER + 1) -> Series:
+    return [c] + [_zero(c[0]) for _ in range(n - 1)]
 
 
-def _trig(phi: Iv, alpha: Pair, L: Pair) -> tuple[Series, Series]:
+def _trig(phi: Iv, alpha: Pair, L: Pair, n: int = ORDER + 1) -> tuple[Series, Series]:
     """L (cos, sin)(phi + alpha) as Taylor arrays: the derivatives of cos run cos, -sin, -cos, sin, ..."""
     c, s = cos_sin(add(phi, _c(alpha, phi[0])))
     neg_c, neg_s = (-c[1], -c[0]), (-s[1], -s[0])
     cycle_c, cycle_s = (c, neg_s, neg_c, s), (s, c, neg_s, neg_c)
     Lv = _c(L, phi[0])
     cs, ss = [], []
-    for j in range(ORDER + 1):
+    for j in range(n):
         inv = _c(_INV_FACT[j], phi[0])  # 1/6 and 1/24 are not floats: enclosed
         cs.append(mul(Lv, mul(cycle_c[j % 4], inv)))
         ss.append(mul(Lv, mul(cycle_s[j % 4], inv)))
     return cs, ss
 
 
-def _parts(k: ReducedConstants, phi: Iv) -> tuple[Series, Series, Series, Series, Series, Series, Series]:
-    """(u_x, u_y, v_x, v_y, kappa_2, kappa_3, D) as Taylor arrays over ``phi``."""
+def _parts(k: ReducedConstants, phi: Iv, n: int = ORDER + 1) -> tuple[Series, Series, Series, Series, Series, Series,
+                                                                      Series]:
+    """(u_x, u_y, v_x, v_y, kappa_2, kappa_3, D) as Taylor arrays over ``phi``, the first n coefficients."""
     like = phi[0]
     m, kappa = [], []
     two = const(2.0, 2.0, like)
     for leg in (0, 1):
-        ex, ey = _trig(phi, k.alpha[leg], k.L[leg])
+        ex, ey = _trig(phi, k.alpha[leg], k.L[leg], n)
         ax, ay = (_c(p, like) for p in k.a[leg])
-        m.append((_s_scale(_s_sub(ex, _s_const(ax)), two), _s_scale(_s_sub(ey, _s_const(ay)), two)))
+        m.append((_s_scale(_s_sub(ex, _s_const(ax, n)), two), _s_scale(_s_sub(ey, _s_const(ay, n)), two)))
         dot = _s_add(_s_scale(ex, ax), _s_scale(ey, ay))
-        kappa.append(_s_add(_s_scale(dot, two), _s_const(_c(k.kappa0[leg], like))))
+        kappa.append(_s_add(_s_scale(dot, two), _s_const(_c(k.kappa0[leg], like), n)))
     (m2x, m2y), (m3x, m3y) = m
     neg = lambda s: [(-hi, -lo) for lo, hi in s]  # noqa: E731 - exact negation of each coefficient
     D = _s_sub(_s_mul(m2x, m3y), _s_mul(m2y, m3x))
     return m3y, neg(m3x), neg(m2y), m2x, kappa[0], kappa[1], D
 
 
-def _phi_terms(k: ReducedConstants, phi: Iv) -> tuple[Series, ...]:
+def _phi_terms(k: ReducedConstants, phi: Iv, n: int = ORDER + 1) -> tuple[Series, ...]:
     """The factors of f that depend on phi alone: with k_i = s_i + kappa_i,
 
         f = s_2^2 U + 2 s_2 s_3 W + s_3^2 V + 2 s_2 P_2 + 2 s_3 P_3 + P_0 - r_1 D^2,
 
     U = |u|^2, V = |v|^2, W = u . v, P_2 = kappa_2 U + kappa_3 W, P_3 = kappa_2 W + kappa_3 V,
     P_0 = kappa_2 P_2 + kappa_3 P_3 (expand |k_2 u + k_3 v|^2).  Returned as (U, V, W, P_2, P_3, P_0, D^2)."""
-    ux, uy, vx, vy, kap2, kap3, D = _parts(k, phi)
+    ux, uy, vx, vy, kap2, kap3, D = _parts(k, phi, n)
     U = _s_add(_s_mul(ux, ux), _s_mul(uy, uy))
     V = _s_add(_s_mul(vx, vx), _s_mul(vy, vy))
     W = _s_add(_s_mul(ux, vx), _s_mul(uy, vy))
@@ -195,7 +196,7 @@ def _r_centred(terms: tuple[Series, ...], r_lo: np.ndarray, r_hi: np.ndarray) ->
     f_nat, grad = _combine(terms, tuple((r_lo[:, i], r_hi[:, i]) for i in range(3)))
     f_mid, _ = _combine(terms, tuple((r0[:, i], r0[:, i]) for i in range(3)))
     out = []
-    for j in range(ORDER + 1):
+    for j in range(len(f_mid)):
         acc = f_mid[j]
         for i in range(3):
             acc = add(acc, mul(grad[i][j], (down(r_lo[:, i] - r0[:, i]), up(r_hi[:, i] - r0[:, i]))))
@@ -214,8 +215,9 @@ def derivative_enclosures(k: ReducedConstants, r_lo: np.ndarray, r_hi: np.ndarra
     if not 0 < orders <= ORDER:
         raise ValueError(f"derivative orders {orders} outside 1..{ORDER}")
     m = np.clip(phi_lo + (phi_hi - phi_lo) / 2, phi_lo, phi_hi)
-    over = _r_centred(_phi_terms(k, (phi_lo, phi_hi)), r_lo, r_hi)
-    at_m = _r_centred(_phi_terms(k, (m, m)), r_lo, r_hi)
+    # the Taylor coefficients up to order ``orders`` are all the forms below use (truncation keeps the others exact)
+    over = _r_centred(_phi_terms(k, (phi_lo, phi_hi), orders + 1), r_lo, r_hi)
+    at_m = _r_centred(_phi_terms(k, (m, m), orders + 1), r_lo, r_hi)
     offset = (down(phi_lo - m), up(phi_hi - m))
     out = []
     for d in range(orders):
@@ -238,8 +240,8 @@ def d_sign(k: ReducedConstants, phi_lo: np.ndarray, phi_hi: np.ndarray) -> np.nd
 
     D does not depend on r.  Natural enclosure met with the mean value form D(m) + D'(Phi) (Phi - m)."""
     m = np.clip(phi_lo + (phi_hi - phi_lo) / 2, phi_lo, phi_hi)
-    over = _parts(k, (phi_lo, phi_hi))[-1]
-    at_m = _parts(k, (m, m))[-1]
+    over = _parts(k, (phi_lo, phi_hi), 2)[-1]
+    at_m = _parts(k, (m, m), 1)[-1]
     lo, hi = _meet(over[0], add(at_m[0], mul(over[1], (down(phi_lo - m), up(phi_hi - m)))))
     return np.where(lo > 0, 1, np.where(hi < 0, -1, 0)).astype(np.int8)
 

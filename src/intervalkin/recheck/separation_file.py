@@ -36,15 +36,18 @@ import numpy as np
 
 from intervalkin.checker.claims import MALFORMED, run_check
 from intervalkin.checker.folder import CheckResult
-from intervalkin.checker.parse import Refused
+from intervalkin.checker.parse import Refused, read_box
 from intervalkin.core.errors import CertificateFormatError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers, default_workers
 from intervalkin.recheck.arith import fraction_enclosure
+from intervalkin.recheck.arc_pattern import MAX_COUNT, box_arcs, face_relations, pattern_of_angles, unpack
 from intervalkin.recheck.count_range import count_ranges, supported
+from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.recheck.paving_file import folder_geometry
 
-__all__ = ["CLAIMS", "ARRAYS", "KIND", "uncovered_boundary", "check_separation", "recheck_separations"]
+__all__ = ["CLAIMS", "ARRAYS", "KIND", "uncovered_boundary", "face_pairs", "check_separation", "check_pattern_separation",
+           "recheck_separations"]
 
 #: Where an output folder keeps the separation claims and their boxes.
 CLAIMS = Path("certificates") / "joint_separation.json"
@@ -54,6 +57,10 @@ KIND = "joint_separation"
 #: Barrier boxes worth sending to a second process at once.
 MIN_PART = 400
 _COLUMNS = ("region_lo", "region_hi", "region_claim", "barrier_lo", "barrier_hi", "barrier_claim")
+#: Columns only pattern barriers need (a file of count barriers alone may lack them).
+_PATTERN_COLUMNS = ("barrier_box", "barrier_outer_lo", "barrier_outer_hi", "pattern_box", "pattern_rows")
+#: Region boxes compared at once when looking for the pairs that share a face.
+_CHUNK = 2048
 
 
 def _cover(u: np.ndarray, w: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -124,35 +131,14 @@ def check_separation(geometry: Geometry, claim: dict, region: tuple[np.ndarray, 
                      barrier: tuple[np.ndarray, np.ndarray], workers: Workers | None = None) -> tuple[str, dict]:
     """Re-prove one claim (module docstring); (statement, facts) or :class:`Refused`.  ``workers`` may share
     the count ranges of the barrier boxes between processes (the same verdict)."""
-    sig = claim.get("signature")
-    if not (isinstance(sig, list) and len(sig) == 3 and all(isinstance(v, int) and 0 <= v <= 6 for v in sig)):
-        raise Refused(f"signature: expected [count, n_wa1, n_wa2], got {sig!r}")
-    sig = tuple(sig)
-    others = claim.get("others")
-    if not isinstance(others, list) or not others:
-        raise Refused("others: expected a non-empty list of witnesses")
     r_lo, r_hi = region
     b_lo, b_hi = barrier
-    for name, (lo, hi) in (("region", region), ("barrier", barrier)):
-        if lo.size == 0 and name == "region":
-            raise Refused("the region holds no box")
-        if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(lo <= hi) and np.all(lo > 0)):
-            raise Refused(f"{name}: boxes need finite bounds with 0 < lo <= hi")
-    if not supported(geometry):
-        raise Refused("count ranges are refused for this geometry (|p_i| = |A_i - A_1| on legs 2 and 3)")
-    x, got = _witness(geometry, claim.get("witness"), "witness")
-    if got != sig:
-        raise Refused(f"witness: its solutions give {got}, not the claimed signature {sig}")
+    sig, x, _, others = _common(geometry, claim, {"region": region, "barrier": barrier})
     x_lo, x_hi = _enclose(x)
-    if not all(Fraction(geometry.rho_min[a]) < x[a] < Fraction(geometry.rho_max[a]) for a in range(3)):
-        raise Refused("the witness is not strictly inside the joint limits")
     if not np.any(np.all((r_lo < x_lo) & (x_hi < r_hi), axis=1)):
         raise Refused("the witness is not inside a box of the region")
     cells = []
-    for k, other in enumerate(others):
-        y, got = _witness(geometry, other, f"others[{k}]")
-        if got != sig:
-            raise Refused(f"others[{k}]: its solutions give {got}, not the claimed signature {sig}")
+    for k, (y, other) in enumerate(others):
         y_lo, y_hi = _enclose(y)
         if np.any(np.all((r_lo <= y_hi) & (y_lo <= r_hi), axis=1)):
             raise Refused(f"others[{k}]: its witness may lie in the region")
@@ -174,17 +160,145 @@ def check_separation(geometry: Geometry, claim: dict, region: tuple[np.ndarray, 
             f"{len(b_lo)} boxes with no point of {sig[0]} solutions"), facts
 
 
+def _common(geometry: Geometry, claim: dict, boxes: dict[str, tuple[np.ndarray, np.ndarray]]):
+    """The checks both kinds share: signature, boxes, the witnesses re-proved.  Returns (signature, witness
+    point, its object, [(other point, its object)])."""
+    sig = claim.get("signature")
+    if not (isinstance(sig, list) and len(sig) == 3 and all(isinstance(v, int) and 0 <= v <= 6 for v in sig)):
+        raise Refused(f"signature: expected [count, n_wa1, n_wa2], got {sig!r}")
+    sig = tuple(sig)
+    others = claim.get("others")
+    if not isinstance(others, list) or not others:
+        raise Refused("others: expected a non-empty list of witnesses")
+    for name, (lo, hi) in boxes.items():
+        if lo.size == 0 and name == "region":
+            raise Refused("the region holds no box")
+        if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(lo <= hi) and np.all(lo > 0)):
+            raise Refused(f"{name}: boxes need finite bounds with 0 < lo <= hi")
+    if not supported(geometry):
+        raise Refused("count ranges are refused for this geometry (|p_i| = |A_i - A_1| on legs 2 and 3)")
+    x, got = _witness(geometry, claim.get("witness"), "witness")
+    if got != sig:
+        raise Refused(f"witness: its solutions give {got}, not the claimed signature {sig}")
+    if not all(Fraction(geometry.rho_min[a]) < x[a] < Fraction(geometry.rho_max[a]) for a in range(3)):
+        raise Refused("the witness is not strictly inside the joint limits")
+    rest = []
+    for k, other in enumerate(others):
+        y, got = _witness(geometry, other, f"others[{k}]")
+        if got != sig:
+            raise Refused(f"others[{k}]: its solutions give {got}, not the claimed signature {sig}")
+        rest.append((y, other))
+    return sig, x, claim["witness"], rest
+
+
+def face_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair i < j of closed boxes whose intersection has dimension 2 or 3 (a shared piece of face, or an
+    overlap): exact float comparisons, in chunks of rows."""
+    n = lo.shape[0]
+    out_i, out_j = [], []
+    for s in range(0, n, _CHUNK):
+        blo, bhi = lo[s:s + _CHUNK, None, :], hi[s:s + _CHUNK, None, :]
+        ext_lo, ext_hi = np.maximum(blo, lo[None]), np.minimum(bhi, hi[None])
+        meet = np.all(ext_lo <= ext_hi, axis=2) & ((ext_lo < ext_hi).sum(axis=2) >= 2)
+        i, j = np.nonzero(meet)
+        i = i + s
+        keep = i < j
+        out_i.append(i[keep])
+        out_j.append(j[keep])
+    return np.concatenate(out_i), np.concatenate(out_j)
+
+
+def _solution_phi(witness: dict) -> tuple[np.ndarray, np.ndarray]:
+    boxes = [read_box(s["box"], f"solution {k}") for k, s in enumerate(witness["solutions"])]
+    return np.array([b[2][0] for b in boxes], dtype=np.float64), np.array([b[2][1] for b in boxes], dtype=np.float64)
+
+
+def check_pattern_separation(geometry: Geometry, claim: dict, region: tuple[np.ndarray, np.ndarray],
+                             patterns: list[set], barrier: tuple[np.ndarray, np.ndarray], barrier_box: np.ndarray,
+                             outer: tuple[np.ndarray, np.ndarray]) -> tuple[str, dict]:
+    """Re-prove one pattern barrier (proofs/lemma-pattern-barrier.md); (statement, facts) or :class:`Refused`.
+
+    ``patterns[i]``: the pattern set of region box i; barrier box j lies in region box ``barrier_box[j]`` and
+    in the box ``outer[.][j]``.  Proves: the witnesses' solution lists (arb); the witness inside a region box
+    whose set holds its pattern, and every other witness, in every region box that may hold it, with a
+    pattern outside the set; on every 2-D (or 3-D) intersection of two region boxes, the face relation links
+    patterns inside the two sets only to each other; on every barrier box, no relation pair starts in its
+    region box's set; the region's boundary inside the open joint box covered by barrier boxes."""
+    r_lo, r_hi = region
+    b_lo, b_hi = barrier
+    o_lo, o_hi = outer
+    sig, x, x_obj, others = _common(geometry, claim, {"region": region, "barrier": barrier,
+                                                      "outer boxes": outer})
+    count = sig[0]
+    if not (np.all(b_lo >= r_lo[barrier_box]) and np.all(b_hi <= r_hi[barrier_box])):
+        raise Refused("a barrier box does not lie in its region box")
+    if not (np.all(b_lo >= o_lo) and np.all(b_hi <= o_hi)):
+        raise Refused("a barrier box does not lie in its outer box")
+    k = reduced_constants(geometry)
+    arcs = box_arcs(k, r_lo, r_hi)
+    x_lo, x_hi = _enclose(x)
+    holds = np.flatnonzero(np.all((r_lo <= x_lo) & (x_hi <= r_hi), axis=1))
+    phi = _solution_phi(x_obj)
+    if not any(pattern_of_angles(arcs.signs[i], *phi) in patterns[i] for i in holds.tolist()):
+        raise Refused("the witness lies in no region box whose pattern set holds its pattern")
+    cells = []
+    for n_o, (y, obj) in enumerate(others):
+        y_lo, y_hi = _enclose(y)
+        phi = _solution_phi(obj)
+        for i in np.flatnonzero(np.all((r_lo <= y_hi) & (y_lo <= r_hi), axis=1)).tolist():
+            got = pattern_of_angles(arcs.signs[i], *phi)
+            if got is None or got in patterns[i]:
+                raise Refused(f"others[{n_o}]: its witness may lie in region box {i} with a pattern of its set")
+        cells.append(obj.get("cell"))
+    pi, pj = face_pairs(r_lo, r_hi)
+    if pi.size:
+        f_lo, f_hi = np.maximum(r_lo[pi], r_lo[pj]), np.minimum(r_hi[pi], r_hi[pj])
+        for t, rel in enumerate(face_relations(k, f_lo, f_hi, arcs.take(pi), arcs.take(pj), count)):
+            i, j = int(pi[t]), int(pj[t])
+            for u, v in rel:
+                if (u in patterns[i]) != (v in patterns[j]):
+                    raise Refused(f"region boxes {i} and {j}: on their shared face pattern {list(u)} of one and "
+                                  f"{list(v)} of the other may meet, and only one is in its box's set")
+    if b_lo.size:
+        rel = face_relations(k, b_lo, b_hi, arcs.take(barrier_box), box_arcs(k, o_lo, o_hi), count)
+        for t, pairs in enumerate(rel):
+            own = patterns[int(barrier_box[t])]
+            if any(u in own for u, _ in pairs):
+                raise Refused(f"barrier box {t} [{b_lo[t].tolist()}, {b_hi[t].tolist()}]: a pattern of its region "
+                              "box's set is not excluded there")
+    missing, first = uncovered_boundary(r_lo, r_hi, b_lo, b_hi, geometry)
+    if missing:
+        ax, v, centre = first
+        raise Refused(f"{missing} cells of the region's boundary lie on no barrier box, the first on rho_{ax + 1} = "
+                      f"{v} around {centre}")
+    facts = {"signature": sig, "cell": claim.get("cell"), "others": cells}
+    return (f"cell {claim.get('cell')} and cells {', '.join(map(str, cells))} ({count} solutions) lie in different "
+            f"components of the joint box minus g(S): {len(r_lo)} region boxes with the patterns of the cell's "
+            f"solutions, {pi.size} shared faces related, the boundary covered by {len(b_lo)} boxes where none of "
+            "those patterns occurs"), facts
+
+
 def _read(folder: Path) -> tuple[dict, dict[str, np.ndarray]]:
     try:
         doc = json.loads((folder / CLAIMS).read_text(encoding="utf-8"))
         with np.load(folder / ARRAYS, allow_pickle=False) as z:
             arrays = {k: np.asarray(z[k]) for k in _COLUMNS}
+            arrays.update({k: np.asarray(z[k]) for k in _PATTERN_COLUMNS if k in z.files})
     except FileNotFoundError as exc:
         raise CertificateFormatError(f"{folder}: {exc.filename} missing beside {CLAIMS}") from None
     except KeyError as exc:
         raise CertificateFormatError(f"{folder / ARRAYS}: column {exc} missing") from None
     except (OSError, ValueError, zipfile.BadZipFile, json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise CertificateFormatError(f"{folder}: cannot read the separation certificate ({exc})") from None
+    n_bar = arrays["barrier_lo"].shape[0]
+    shapes = {"barrier_box": (n_bar,), "barrier_outer_lo": (n_bar, 3), "barrier_outer_hi": (n_bar, 3),
+              "pattern_rows": (arrays.get("pattern_box", np.zeros(0)).shape[0], MAX_COUNT)}
+    for k in _PATTERN_COLUMNS:
+        if k in arrays:
+            kind = "f" if k.startswith("barrier_outer") else "i"
+            if arrays[k].dtype.kind != kind or (k in shapes and arrays[k].shape != shapes[k]) or (
+                    k == "pattern_box" and arrays[k].ndim != 1):
+                raise CertificateFormatError(f"{folder / ARRAYS}: {k} has the wrong type or shape")
     if not isinstance(doc, dict) or not isinstance(doc.get("claims"), list):
         raise CertificateFormatError(f"{folder / CLAIMS}: claims: expected a list")
     for k in ("region_lo", "region_hi", "barrier_lo", "barrier_hi"):
@@ -221,8 +335,28 @@ def _one(geometry: Geometry, j: int, claim, arrays: dict, workers: Workers) -> C
         if not isinstance(claim, dict) or claim.get("region") != j:
             raise Refused(f"claim {j}: expected an object whose region is {j}")
         rows, walls = arrays["region_claim"] == j, arrays["barrier_claim"] == j
-        msg, _ = check_separation(geometry, claim, (arrays["region_lo"][rows], arrays["region_hi"][rows]),
-                                  (arrays["barrier_lo"][walls], arrays["barrier_hi"][walls]), workers)
+        region = (arrays["region_lo"][rows], arrays["region_hi"][rows])
+        barrier = (arrays["barrier_lo"][walls], arrays["barrier_hi"][walls])
+        if claim.get("kind", "count") == "pattern":
+            if any(k not in arrays for k in _PATTERN_COLUMNS):
+                raise Refused("a pattern barrier needs the npz columns " + ", ".join(_PATTERN_COLUMNS))
+            index = np.flatnonzero(rows)
+            local = np.full(rows.size, -1, dtype=np.int64)
+            local[index] = np.arange(index.size)
+            box = arrays["barrier_box"][walls]
+            if np.any((box < 0) | (box >= rows.size)) or np.any(local[np.clip(box, 0, rows.size - 1)] < 0):
+                raise Refused("barrier_box: a barrier row points to no region box of its claim")
+            mine = (arrays["pattern_box"] >= 0) & (arrays["pattern_box"] < rows.size)
+            mine[mine] &= rows[arrays["pattern_box"][mine]]
+            patterns: list[set] = [set() for _ in range(index.size)]
+            for r, pat in zip(local[arrays["pattern_box"][mine]].tolist(), unpack(arrays["pattern_rows"][mine])):
+                patterns[r].add(pat)
+            msg, _ = check_pattern_separation(geometry, claim, region, patterns, barrier, local[box],
+                                              (arrays["barrier_outer_lo"][walls], arrays["barrier_outer_hi"][walls]))
+        elif claim.get("kind", "count") == "count":
+            msg, _ = check_separation(geometry, claim, region, barrier, workers)
+        else:
+            raise Refused(f"kind: expected count or pattern, got {claim.get('kind')!r}")
     except Refused as exc:
         return CheckResult(CLAIMS.name, name, KIND, False, str(exc))
     return CheckResult(CLAIMS.name, name, KIND, True, f"{msg} ({time.perf_counter() - t0:.1f} s)")

@@ -1,0 +1,130 @@
+"""Arcs, patterns and face relations (recheck.arc_pattern) hold the certified solver's solutions.
+
+At random points of random joint boxes of the paper's manipulator and of the second design, the
+library's certified solver (a complete solve) places each solution in an arc of the box: the counts
+per arc lie in the proved ranges, with the proved parities.  At random points of random faces shared
+by two boxes, the pair of patterns the solutions give, seen from each box, is in the face relation.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+import intervalkin.recheck.arc_pattern as ap
+from intervalkin.core.geometry import load_geometry
+from intervalkin.recheck.reduced_equation import reduced_constants
+from intervalkin.solve.dkp import solve
+from tests.conftest import SECOND_DESIGN
+
+
+@pytest.fixture(scope="module", params=["paper", "second"])
+def geometry(request, paper_geometry):
+    return paper_geometry if request.param == "paper" else load_geometry(SECOND_DESIGN)
+
+
+def _boxes(geometry, seed: int, n: int, widest: float = -0.5):
+    rng = np.random.default_rng(seed)
+    lo_lim = np.array([float(v) for v in geometry.rho_min])
+    hi_lim = np.array([float(v) for v in geometry.rho_max])
+    w = 10.0 ** rng.uniform(-2, widest, (n, 3))
+    lo = rng.uniform(lo_lim, hi_lim - 2 * w)
+    return lo, lo + w, rng
+
+
+def _solve(geometry, q):
+    res = solve(geometry, tuple(Fraction(float(v)) for v in q))
+    if not res.complete:
+        return None
+    return np.array([s.box[2][0] for s in res.solutions]), np.array([s.box[2][1] for s in res.solutions])
+
+
+def _arc_counts(signs, phi_lo, phi_hi):
+    """Solutions per arc start (a dict), or None when one sits too near a cut to be placed."""
+    pat = ap.pattern_of_angles(signs, phi_lo, phi_hi)
+    if pat is None:
+        return None
+    out: dict[int, int] = {}
+    for s in pat:
+        out[s] = out.get(s, 0) + 1
+    return out
+
+
+def _samples(geometry, seed=21, n=40, per_box=3):
+    k = reduced_constants(geometry)
+    lo, hi, rng = _boxes(geometry, seed, n)
+    arcs = ap.box_arcs(k, lo, hi)
+    seen = []
+    for i in range(n):
+        for _ in range(per_box):
+            got = _solve(geometry, rng.uniform(lo[i], hi[i]))
+            if got is not None:
+                seen.append((i, _arc_counts(arcs.signs[i], *got), got[0].size))
+    return arcs, seen
+
+
+def test_arc_ranges_hold_the_solver_counts(geometry):
+    arcs, seen = _samples(geometry)
+    assert len(seen) > 80
+    odd_checked = 0
+    for i, counts, total in seen:
+        assert counts is not None
+        cuts = np.flatnonzero(arcs.signs[i] != 0)
+        if cuts.size == 0:
+            assert arcs.whole_lo[i] <= total <= arcs.whole_hi[i]
+            continue
+        for s in cuts.tolist():
+            c = counts.get(s, 0)
+            assert arcs.lo[i, s] <= c <= arcs.hi[i, s], (i, s, c, arcs.lo[i, s], arcs.hi[i, s])
+            if arcs.parity[i, s] >= 0:
+                assert c % 2 == arcs.parity[i, s]
+                odd_checked += int(arcs.parity[i, s] == 1)
+        assert set(counts) <= set(cuts.tolist())
+    assert odd_checked > 20  # the parity rule is exercised, in its odd case too
+
+
+def test_a_wrong_parity_rule_is_caught(paper_geometry):
+    """Parities turned round would contradict the solver at the sampled points."""
+    arcs, seen = _samples(paper_geometry, seed=22, n=20, per_box=2)
+    wrong = 0
+    for i, counts, _ in seen:
+        for s in np.flatnonzero((arcs.signs[i] != 0) & (arcs.parity[i] >= 0)).tolist():
+            wrong += counts.get(s, 0) % 2 != 1 - arcs.parity[i, s]
+    assert wrong > 0
+
+
+def test_face_relations_hold_the_patterns_of_points(geometry):
+    k = reduced_constants(geometry)
+    lo, hi, rng = _boxes(geometry, 23, 40)
+    axis = rng.integers(0, 3, lo.shape[0])
+    shift = np.zeros_like(lo)
+    shift[np.arange(lo.shape[0]), axis] = (hi - lo)[np.arange(lo.shape[0]), axis]
+    lo2, hi2 = lo + shift, hi + shift  # the neighbour across the face x_axis = hi
+    f_lo, f_hi = np.maximum(lo, lo2), np.minimum(hi, hi2)
+    a, b = ap.box_arcs(k, lo, hi), ap.box_arcs(k, lo2, hi2)
+    checked = 0
+    for i in range(lo.shape[0]):
+        for _ in range(3):
+            q = rng.uniform(f_lo[i], f_hi[i])
+            got = _solve(geometry, q)
+            if got is None:
+                continue
+            pa, pb = ap.pattern_of_angles(a.signs[i], *got), ap.pattern_of_angles(b.signs[i], *got)
+            rel = ap.face_relations(k, f_lo[i][None], f_hi[i][None], a.take(np.array([i])), b.take(np.array([i])),
+                                    got[0].size)[0]
+            assert (pa, pb) in rel, (i, pa, pb, rel)
+            checked += 1
+    assert checked > 80
+
+
+def test_witness_patterns_need_the_arcs_decided():
+    signs = np.zeros(ap.GRID, dtype=np.int8)
+    signs[[3, 40]] = 1
+    ang = ap.cut_angles()
+    assert ap.pattern_of_angles(signs, np.array([ang[10]]), np.array([ang[11]])) == (3,)
+    assert ap.pattern_of_angles(signs, np.array([ang[50], 0.0]), np.array([ang[50], 0.0])) == (3, 40)
+    assert ap.pattern_of_angles(signs, np.array([ang[2]]), np.array([ang[4]])) is None  # a cut inside
+    assert ap.pattern_of_angles(np.zeros(ap.GRID, dtype=np.int8), np.array([1.0]), np.array([1.0])) == (ap.WHOLE,)
+    assert ap.unpack(ap.pack([(3, 40), ()])) == [(3, 40), ()]
