@@ -210,9 +210,10 @@ def add_separation_bound(summary: dict) -> None:
     n = sep["basic_regions_at_least"]
     block["separations_at_least"] = n
     block["why"] += (f"; the separations of cells of one signature (joint_cells.separations, "
-                     f"proofs/lemma-separation.md) prove at least {n}, but those between cells with solutions rest "
-                     "on window patterns, not yet in the certificates (only count barriers are, "
-                     "joint_cells.separations.count_barriers), so intervalkin verify does not re-prove that bound")
+                     f"proofs/lemma-separation.md) prove at least {n}, but some of those between cells with "
+                     "solutions rest on window patterns only, not in the certificates (the count and pattern barriers "
+                     "are: joint_cells.separations.count_barriers), so intervalkin verify does not re-prove that "
+                     "bound")
 
 
 def add_barrier_certificates(summary: dict, claims: list[dict]) -> None:

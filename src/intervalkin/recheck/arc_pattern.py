@@ -29,7 +29,7 @@ import numpy as np
 
 from intervalkin.recheck.arith import PI_HI, PI_LO
 from intervalkin.recheck.count_range import NO_BOUND, PIECES, arc_ranges, r_box
-from intervalkin.recheck.reduced_equation import ReducedConstants, d_sign, sign_at_points
+from intervalkin.recheck.reduced_equation import ReducedConstants, d_sign, derivative_enclosures, sign_at_points
 
 __all__ = ["GRID", "WHOLE", "MAX_COUNT", "cut_angles", "cut_signs", "arc_starts", "ArcTable", "arc_table",
            "BoxArcs", "box_arcs", "face_relations", "pattern_of_angles", "pack", "unpack"]
@@ -102,22 +102,36 @@ def arc_table(k: ReducedConstants, q_lo: np.ndarray, q_hi: np.ndarray, signs: np
     nxt[last[has]] = first[has]
     end = start[nxt] if owner.size else start
     wraps = end <= start
-    # pieces for arc_ranges: a wrapping arc is [c_s, pi] and [-pi, c_e]
-    p_arc = np.concatenate([np.arange(owner.size), np.flatnonzero(wraps)])
-    p_a = np.concatenate([ang[start], np.full(int(wraps.sum()), -np.pi)])
-    p_b = np.concatenate([np.where(wraps, np.pi, ang[end]), ang[end[wraps]]])
-    p_box = owner[p_arc]
-    rng = arc_ranges(k, r_lo, r_hi, p_box, p_a, p_b, ARC_PIECES)
     lo = np.zeros(owner.size, dtype=np.int64)
     hi = np.zeros(owner.size, dtype=np.int64)
+    d_ok = np.ones(owner.size, dtype=bool)
+    # most arcs are one grid step where f keeps one sign: no root, no solution, even parity (one cheap enclosure
+    # of f, its first two Taylor coefficients, instead of a range); the seam step is taken as its two halves
+    step = np.flatnonzero(end == (start + 1) % grid)
+    seam = wraps[step]
+    e_arc = np.concatenate([step, step[seam]])
+    e_a = np.concatenate([ang[start[step]], np.full(int(seam.sum()), -PI_HI)])
+    e_b = np.concatenate([np.where(seam, PI_HI, ang[end[step]]), ang[end[step[seam]]]])
+    f_lo, f_hi = derivative_enclosures(k, r_lo[owner[e_arc]], r_hi[owner[e_arc]], e_a, e_b, 1)[0]
+    signed = np.ones(owner.size, dtype=bool)
+    np.logical_and.at(signed, e_arc, (f_lo > 0) | (f_hi < 0))
+    free = np.zeros(owner.size, dtype=bool)
+    free[step] = signed[step]
+    # the other arcs: ranges (a wrapping arc is [c_s, pi] and [-pi, c_e])
+    rest = np.flatnonzero(~free)
+    r_wrap = wraps[rest]
+    p_arc = np.concatenate([rest, rest[r_wrap]])
+    p_a = np.concatenate([ang[start[rest]], np.full(int(r_wrap.sum()), -np.pi)])
+    p_b = np.concatenate([np.where(r_wrap, np.pi, ang[end[rest]]), ang[end[rest[r_wrap]]]])
+    rng = arc_ranges(k, r_lo, r_hi, owner[p_arc], p_a, p_b, ARC_PIECES)
     np.add.at(lo, p_arc, rng.lo)
     np.add.at(hi, p_arc, rng.hi)
     d_lo = np.where(p_a <= -PI_LO, -PI_HI, p_a)
     d_hi = np.where(p_b >= PI_LO, PI_HI, p_b)
-    d_ok = np.ones(owner.size, dtype=bool)
     np.logical_and.at(d_ok, p_arc, d_sign(k, d_lo, d_hi) != 0)
     s = signs[owner, start].astype(np.int64), signs[owner, end].astype(np.int64)
     parity = np.where(d_ok, (s[0] != s[1]).astype(np.int64), -1)
+    parity[free] = 0
     # boxes without a cut: one arc, the whole circle, no parity
     none = np.flatnonzero(~has)
     if none.size:
