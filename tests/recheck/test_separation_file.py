@@ -217,3 +217,30 @@ def test_the_folder_is_read_and_a_corrupt_file_is_a_format_error(built, paper_ge
         recheck_separations(tmp_path)
     assert recheck_separations(tmp_path / "nothing") == []
     json.loads((tmp_path / CLAIMS).read_text())
+
+
+def test_the_summary_bound_of_the_barriers_is_checked(built, paper_geometry, tmp_path):
+    """verify adds one verdict on summary.json's basic_regions.barriers_at_least: the counts claim's bound plus n
+    per separated cell of n solutions, over the claims it verified; a higher stated number fails."""
+    from intervalkin.recheck.separation_file import barrier_bound
+
+    claims = [{"signature": [2, 1, 1], "cell": 9}, {"signature": [4, 2, 2], "cell": 3},
+              {"signature": [4, 2, 2], "cell": 3}, {"signature": [0, 0, 0], "cell": 7}]
+    assert barrier_bound(12, claims, [True, True, True, True]) == 12 + 2 + 4  # cell 3 counted once
+    assert barrier_bound(12, claims, [False, True, True, True]) == 16
+    c, arrays, _ = built
+    write_json(tmp_path / "certificates" / "index.json", {"geometry_toml": paper_geometry.to_toml()})
+    write_json(tmp_path / "certificates" / "counts.json", {"claims": [{"name": "basic_regions", "lower_bound": 12}]})
+    write_json(tmp_path / CLAIMS, {"claims": c[:1]})
+    keep = dict(arrays)
+    walls, rows = keep["barrier_claim"] == 0, keep["region_claim"] == 0
+    for k in ("barrier_box", "barrier_outer_lo", "barrier_outer_hi", "barrier_lo", "barrier_hi", "barrier_claim"):
+        keep[k] = keep[k][walls]
+    for k in ("region_lo", "region_hi", "region_claim"):
+        keep[k] = keep[k][rows]
+    keep["pattern_box"], keep["pattern_rows"] = keep["pattern_box"][:0], keep["pattern_rows"][:0]
+    np.savez(tmp_path / ARRAYS, **keep)
+    for stated, ok in ((12, True), (13, False)):
+        write_json(tmp_path / "summary.json", {"basic_regions": {"barriers_at_least": stated}})
+        last = recheck_separations(tmp_path)[-1]
+        assert last.kind == "barrier_bound" and last.verified is ok, last.line()

@@ -254,12 +254,16 @@ def add_barrier_certificates(summary: dict, claims: list[dict]) -> None:
                      "re-proved by intervalkin verify",
     }
     block = summary.get("basic_regions")
-    if block is not None and regions > block.get("lower_bound", block.get("lower", 0)):
-        block["barriers_at_least"] = regions
+    lower = None if block is None else block.get("lower_bound", block.get("lower"))
+    # what verify re-proves (recheck.separation_file.barrier_bound): the counts claim's bound, plus n for each cell
+    # of n solutions told apart from the others of its signature
+    proved = None if lower is None else lower + sum(sig[0] * len(set(cells)) for sig, cells in by_sig.items())
+    if proved is not None and proved > lower:
+        block["barriers_at_least"] = proved
         block["why"] = block.get("why", "") + (
             f"; the count and pattern barriers of certificates/joint_separation.json, re-proved by intervalkin "
-            f"verify, prove at least {regions} (components of the joint box minus g(S) per signature, times its "
-            "count; the counts claim does not use them yet)")
+            f"verify, prove at least {proved} (each cell of n solutions told apart from the others of its "
+            "signature is one more component, n more basic regions; the counts claim does not use them yet)")
 
 
 def chain_table(summary: dict) -> str:

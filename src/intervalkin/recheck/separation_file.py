@@ -47,7 +47,7 @@ from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.recheck.paving_file import folder_geometry
 
 __all__ = ["CLAIMS", "ARRAYS", "KIND", "uncovered_boundary", "face_pairs", "check_separation", "check_pattern_separation",
-           "recheck_separations"]
+           "recheck_separations", "barrier_bound"]
 
 #: Where an output folder keeps the separation claims and their boxes.
 CLAIMS = Path("certificates") / "joint_separation.json"
@@ -324,7 +324,45 @@ def recheck_separations(folder: str | Path) -> list[CheckResult]:
     with Workers(default_workers(), min_items=MIN_PART) as workers:
         for j, claim in enumerate(doc["claims"]):
             out.append(_one(geometry, j, claim, arrays, workers))
-    return out
+    bound = _summary_bound(root, doc["claims"], out)
+    return out + ([] if bound is None else [bound])
+
+
+def barrier_bound(counts_lower: int, claims: list, verified: list[bool]) -> int:
+    """The basic regions the verified barriers prove beside the counts claim's lower bound L (Theorem 1 over the
+    distinct aspect splits of the verified solves): L plus, for each signature, count times the number of its
+    distinct cells with a verified claim.  Each such cell is apart from every other cell of its signature, so k of
+    them make k + 1 components, and L holds one of each signature it counts at most (one more component of n
+    solutions is n more basic regions; a signature L misses only makes the sum smaller than the truth)."""
+    cells: dict[tuple, set] = {}
+    for claim, ok in zip(claims, verified):
+        if ok:
+            cells.setdefault(tuple(claim["signature"]), set()).add(claim.get("cell"))
+    return counts_lower + sum(sig[0] * len(c) for sig, c in cells.items())
+
+
+def _summary_bound(root: Path, claims: list, results: list[CheckResult]) -> CheckResult | None:
+    """When ``summary.json`` states ``basic_regions.barriers_at_least``, one more verdict: that number may not
+    exceed :func:`barrier_bound` over the claims verified here and the counts claim's lower bound (which
+    ``verify`` re-proves apart)."""
+    try:
+        summary = json.loads((root / "summary.json").read_text(encoding="utf-8"))
+        stated = summary["basic_regions"]["barriers_at_least"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    try:
+        counts = json.loads((root / "certificates" / "counts.json").read_text(encoding="utf-8"))
+        lower = next(int(c["lower_bound"]) for c in counts["claims"] if c.get("name") == "basic_regions")
+    except (OSError, ValueError, KeyError, TypeError, StopIteration):
+        return CheckResult("summary.json", "basic_regions", "barrier_bound", False,
+                           "barriers_at_least is stated but counts.json has no basic_regions lower bound to add to")
+    proved = barrier_bound(lower, claims, [r.verified for r in results])
+    if not isinstance(stated, int) or stated > proved:
+        return CheckResult("summary.json", "basic_regions", "barrier_bound", False,
+                           f"barriers_at_least = {stated!r} but the verified barriers prove {proved}")
+    return CheckResult("summary.json", "basic_regions", "barrier_bound", True,
+                       f"basic regions >= {proved}: the counts claim's {lower} and the verified barriers "
+                       f"(summary.json states {stated})")
 
 
 def _one(geometry: Geometry, j: int, claim, arrays: dict, workers: Workers) -> CheckResult:
