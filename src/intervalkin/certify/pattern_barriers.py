@@ -34,10 +34,10 @@ from fractions import Fraction
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.recheck.arc_pattern import BoxArcs, box_arcs, face_relations, pattern_of_angles
+from intervalkin.recheck.arc_pattern import FIELDS, BoxArcs, box_arcs, face_relations, pattern_of_angles
 from intervalkin.recheck.reduced_equation import reduced_constants
 
-__all__ = ["FACE_BUDGET", "PatternBarrier", "flood", "solution_pattern"]
+__all__ = ["FACE_BUDGET", "RIVAL_BOXES", "PatternBarrier", "flood", "solution_pattern", "merged_paving", "centre"]
 
 #: Faces whose relation a flood may compute before it is given up (about 1.5 ms each, plus the boxes).
 FACE_BUDGET = 20000
@@ -75,7 +75,8 @@ def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: 
           start: tuple[int, tuple], forbidden: dict[int, set],
           rivals: np.ndarray | None = None, budget: int = FACE_BUDGET) -> tuple[PatternBarrier | None, str, int]:
     """The pattern barrier grown from ``start`` = (leaf, pattern) over boxes [lo, hi] with face contacts (a, b),
-    or None; why not; the number of faces related.  ``forbidden``: leaf -> patterns that must not be reached (other witnesses).
+    or None; why not; the number of faces related.  ``forbidden``: leaf -> patterns that must not be reached
+    (other witnesses).
     ``rivals``: boxes of other cells of the signature; a flood that gives patterns to more than :data:`RIVAL_BOXES`
     of them is leaking into another cell and is given up (a choice of effort: the lemma does not need it)."""
     k = reduced_constants(geometry)
@@ -179,9 +180,7 @@ def merged_paving(level: np.ndarray, ijk: np.ndarray, label: np.ndarray) -> tupl
         owner_of = np.arange(level.size)
         owner_of[merged] = new_id[group]
         owner = owner_of[owner]
-        alive = np.ones(level.size, dtype=bool)
-        alive[gone] = False
-        level[gone] = -1  # removed below
+        level[gone] = -1  # dropped below; -2 keeps them out of later merges
         label[gone] = -2
     alive = level >= 0
     new_index = np.cumsum(alive) - 1
@@ -191,9 +190,9 @@ def merged_paving(level: np.ndarray, ijk: np.ndarray, label: np.ndarray) -> tupl
 def _stack(parts: list[BoxArcs]) -> BoxArcs:
     if len(parts) == 1:
         return parts[0]
-    return BoxArcs(*(np.concatenate([getattr(p, f) for p in parts])
-                     for f in ("signs", "end", "lo", "hi", "parity", "whole_lo", "whole_hi")))
+    return BoxArcs(*(np.concatenate([getattr(p, f) for p in parts]) for f in FIELDS))
 
 
 def centre(lo: np.ndarray, hi: np.ndarray, leaf: int) -> tuple[Fraction, Fraction, Fraction]:
+    """The float centre of box ``leaf``, as exact rationals (a witness point)."""
     return tuple(Fraction(float(v)) for v in 0.5 * (lo[leaf] + hi[leaf]))

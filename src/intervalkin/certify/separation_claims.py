@@ -47,7 +47,8 @@ from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.space.joint_closure import piece_cells
 from intervalkin.space.joint_separation import ANY, possible_counts
 
-__all__ = ["PATTERN_BUDGET", "pattern_barriers", "GROW_ROUNDS", "FACE_BUDGET", "TOTAL_FACE_BUDGET", "SHRINK", "SAMPLE", "MAX_FAIL_SHARE",
+__all__ = ["PATTERN_BUDGET", "pattern_barriers", "GROW_ROUNDS", "FACE_BUDGET", "TOTAL_FACE_BUDGET", "SHRINK", "SAMPLE",
+           "MAX_FAIL_SHARE",
            "CountBarrier", "count_barriers", "separation_claims"]
 
 #: Rounds of moving failed faces outward before a region is given up.
@@ -86,10 +87,6 @@ class CountBarrier:
     barrier_hi: np.ndarray
     witness: tuple[Fraction, Fraction, Fraction]
     other_witnesses: tuple[tuple[Fraction, Fraction, Fraction], ...]
-
-
-def _centre(p, leaf: int) -> tuple[Fraction, Fraction, Fraction]:
-    return tuple(Fraction(float(v)) for v in 0.5 * (p.lo[leaf] + p.hi[leaf]))
 
 
 def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET,
@@ -135,7 +132,7 @@ def count_barriers(jp, geometry: Geometry, face_budget: int = FACE_BUDGET,
             barriers.append(CountBarrier(
                 c.id, tuple(int(v) for v in sig), tuple(o.id for o in others), p.lo[region], p.hi[region],
                 np.maximum(p.lo[a[faces]], p.lo[b[faces]]), np.minimum(p.hi[a[faces]], p.hi[b[faces]]),
-                _centre(p, clear(c.id)), tuple(_centre(p, clear(o.id)) for o in others)))
+                centre(p.lo, p.hi, clear(c.id)), tuple(centre(p.lo, p.hi, clear(o.id)) for o in others)))
     return barriers, omitted
 
 
@@ -186,9 +183,9 @@ def _grow(geometry: Geometry, p, a: np.ndarray, b: np.ndarray, region: np.ndarra
 def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
                      budget: int = PATTERN_BUDGET) -> tuple[list[tuple[dict, list[dict], PatternBarrier]], list[dict]]:
     """Pattern barriers (:mod:`intervalkin.certify.pattern_barriers`) for the cells with solutions whose signature
-    two cells or more share: for a signature with k cells, barriers are tried cell by cell until k - 1 are found
-    (enough to tell every pair apart).  Returns (witness, other witnesses (with ``cell``), barrier) per barrier
-    and what was left out."""
+    two cells or more share: for a signature with k cells, barriers are tried cell by cell, smallest first, until
+    k - 1 are found (enough to tell every pair apart).  Returns (witness, other witnesses (with ``cell``),
+    barrier, cell, signature) per barrier and what was left out."""
     p = jp.paving
     out, omitted = [], []
     if not supported(geometry):
@@ -214,7 +211,8 @@ def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
         for i, c in enumerate(mine):
             got, why = witness_end(geometry, centre(p.lo, p.hi, leaf[c.id]), precision)
             if got is None or (got["count"], got["n_wa1"], got["n_wa2"]) != tuple(sig):
-                omitted.append({"what": f"pattern barrier of cell {c.id}", "why": why or "its witness's signature differs"})
+                omitted.append({"what": f"pattern barrier of cell {c.id}",
+                                "why": why or "its witness's signature differs"})
                 continue
             ends[c.id], pats[c.id] = got, solution_pattern(arcs, i, got)
         # the smallest cells first: a region holds its whole cell, and k - 1 barriers tell k cells apart
@@ -226,7 +224,8 @@ def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
                 break
             others = [o for o in mine if o.id != c.id]
             if any(o.id not in ends or pats[o.id] is None for o in others):
-                omitted.append({"what": f"pattern barrier of cell {c.id}", "why": "another cell's witness has no pattern"})
+                omitted.append({"what": f"pattern barrier of cell {c.id}",
+                                "why": "another cell's witness has no pattern"})
                 continue
             if boxes[c.id] * FACES_PER_BOX > min(budget, TOTAL_PATTERN_BUDGET - spent):
                 # the region holds the whole cell, and each box brings about FACES_PER_BOX faces: it cannot close

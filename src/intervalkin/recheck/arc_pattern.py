@@ -146,6 +146,10 @@ def arc_table(k: ReducedConstants, q_lo: np.ndarray, q_hi: np.ndarray, signs: np
     return ArcTable(owner.astype(np.int64), start.astype(np.int64), end.astype(np.int64), lo, hi, parity)
 
 
+#: The array fields of :class:`BoxArcs`, in order.
+FIELDS = ("signs", "end", "lo", "hi", "parity", "whole_lo", "whole_hi")
+
+
 @dataclass(frozen=True)
 class BoxArcs:
     """The arcs of a batch of boxes, dense over the grid: for box i and a cut j of it (``signs[i, j] != 0``),
@@ -162,7 +166,7 @@ class BoxArcs:
     whole_hi: np.ndarray
 
     def take(self, rows: np.ndarray) -> "BoxArcs":
-        return BoxArcs(*(getattr(self, f)[rows] for f in ("signs", "end", "lo", "hi", "parity", "whole_lo", "whole_hi")))
+        return BoxArcs(*(getattr(self, f)[rows] for f in FIELDS))
 
 
 def box_arcs(k: ReducedConstants, q_lo: np.ndarray, q_hi: np.ndarray, grid: int = GRID) -> BoxArcs:

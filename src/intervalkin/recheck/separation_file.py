@@ -46,8 +46,8 @@ from intervalkin.recheck.count_range import count_ranges, supported
 from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.recheck.paving_file import folder_geometry
 
-__all__ = ["CLAIMS", "ARRAYS", "KIND", "uncovered_boundary", "face_pairs", "check_separation", "check_pattern_separation",
-           "recheck_separations", "barrier_bound"]
+__all__ = ["CLAIMS", "ARRAYS", "KIND", "uncovered_boundary", "face_pairs", "check_separation",
+           "check_pattern_separation", "recheck_separations", "barrier_bound"]
 
 #: Where an output folder keeps the separation claims and their boxes.
 CLAIMS = Path("certificates") / "joint_separation.json"
