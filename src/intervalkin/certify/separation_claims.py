@@ -190,6 +190,10 @@ def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
     out, omitted = [], []
     if not supported(geometry):
         return out, omitted
+    if getattr(jp, "windows", None) is None:
+        # a preview paving (no window models: g(S) not resolved near its folds and crossings), where the library
+        # attempts no separations either; a flood there would spend its budget and close nothing
+        return out, [{"what": "pattern barriers", "why": "the joint paving has no window models (a preview)"}]
     by_sig: dict[tuple, list] = {}
     for c in jp.cells:
         if c.signature[0] > 0 and np.any(jp.cell == c.id):
