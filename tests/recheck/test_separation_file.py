@@ -244,3 +244,20 @@ def test_the_summary_bound_of_the_barriers_is_checked(built, paper_geometry, tmp
         write_json(tmp_path / "summary.json", {"basic_regions": {"barriers_at_least": stated}})
         last = recheck_separations(tmp_path)[-1]
         assert last.kind == "barrier_bound" and last.verified is ok, last.line()
+
+
+def test_a_folder_with_a_pattern_barrier_verifies_and_a_torn_tie_is_refused(every, paper_geometry, tmp_path):
+    """The whole file as the builder writes it (count and pattern claims in one npz) is re-proved claim by claim;
+    a pattern barrier whose wall rows point to no region box of the claim is refused, not a crash."""
+    claims, arrays, _ = every
+    write_json(tmp_path / "certificates" / "index.json", {"geometry_toml": paper_geometry.to_toml()})
+    write_json(tmp_path / CLAIMS, {"claims": claims})
+    np.savez(tmp_path / ARRAYS, **arrays)
+    results = recheck_separations(tmp_path)
+    assert len(results) == len(claims) and all(r.verified for r in results), [r.line() for r in results]
+    j = next(j for j, c in enumerate(claims) if c.get("kind") == "pattern")
+    torn = dict(arrays)
+    torn["barrier_box"] = np.where(arrays["barrier_claim"] == j, -1, arrays["barrier_box"])
+    np.savez(tmp_path / ARRAYS, **torn)
+    got = recheck_separations(tmp_path)[j]
+    assert not got.verified and "barrier_box" in got.message
