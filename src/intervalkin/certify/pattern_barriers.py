@@ -89,7 +89,6 @@ def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: 
     ends, other, face = ends[at], other[at], face[at]
     ptr = np.searchsorted(ends, np.arange(n + 1))
     row = np.full(n, -1, dtype=np.int64)
-    arcs: list[BoxArcs] = []
     rel: dict[int, set] = {}
     found: dict[int, set] = {}
     leaf0, pat0 = start
@@ -102,10 +101,9 @@ def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: 
         need = np.unique(np.concatenate([fl, other[inc]]))
         need = need[row[need] < 0]
         if need.size:
-            arcs.append(box_arcs(k, lo[need], hi[need]))
             row[need] = np.arange(need.size) + (0 if table is None else table.signs.shape[0])
-            table = _stack(arcs)
-            arcs = [table]
+            fresh = box_arcs(k, lo[need], hi[need])
+            table = fresh if table is None else _stack([table, fresh])
         new = np.unique(face[inc])
         new = new[[f not in rel for f in new.tolist()]] if new.size else new
         if len(rel) + new.size > budget:
@@ -188,8 +186,6 @@ def merged_paving(level: np.ndarray, ijk: np.ndarray, label: np.ndarray) -> tupl
 
 
 def _stack(parts: list[BoxArcs]) -> BoxArcs:
-    if len(parts) == 1:
-        return parts[0]
     return BoxArcs(*(np.concatenate([getattr(p, f) for p in parts]) for f in FIELDS))
 
 

@@ -108,6 +108,16 @@ def uncovered_boundary(region_lo: np.ndarray, region_hi: np.ndarray, barrier_lo:
     return missing, first
 
 
+def _require_covered(r_lo: np.ndarray, r_hi: np.ndarray, b_lo: np.ndarray, b_hi: np.ndarray,
+                     geometry: Geometry) -> None:
+    """Refuse unless the region's boundary inside the open joint box lies on the barrier boxes."""
+    missing, first = uncovered_boundary(r_lo, r_hi, b_lo, b_hi, geometry)
+    if missing:
+        ax, v, centre = first
+        raise Refused(f"{missing} cells of the region's boundary lie on no barrier box, the first on rho_{ax + 1} = "
+                      f"{v} around {centre}")
+
+
 def _witness(geometry: Geometry, obj, what: str) -> tuple[tuple[Fraction, ...], tuple[int, int, int]]:
     """The witness point and its (count, n_wa1, n_wa2), its complete solution list re-proved in arb."""
     if not isinstance(obj, dict):
@@ -149,11 +159,7 @@ def check_separation(geometry: Geometry, claim: dict, region: tuple[np.ndarray, 
         i = int(np.flatnonzero(~free)[0])
         raise Refused(f"{int((~free).sum())} barrier boxes not proved free of {sig[0]} solutions, the first "
                       f"[{b_lo[i].tolist()}, {b_hi[i].tolist()}]")
-    missing, first = uncovered_boundary(r_lo, r_hi, b_lo, b_hi, geometry)
-    if missing:
-        ax, v, centre = first
-        raise Refused(f"{missing} cells of the region's boundary lie on no barrier box, the first on rho_{ax + 1} = "
-                      f"{v} around {centre}")
+    _require_covered(r_lo, r_hi, b_lo, b_hi, geometry)
     facts = {"signature": sig, "cell": claim.get("cell"), "others": cells}
     return (f"cell {claim.get('cell')} and cells {', '.join(map(str, cells))} ({sig[0]} solutions) lie in different "
             f"components of the joint box minus g(S): {len(r_lo)} region boxes, their boundary covered by "
@@ -266,11 +272,7 @@ def check_pattern_separation(geometry: Geometry, claim: dict, region: tuple[np.n
             if any(u in own for u, _ in pairs):
                 raise Refused(f"barrier box {t} [{b_lo[t].tolist()}, {b_hi[t].tolist()}]: a pattern of its region "
                               "box's set is not excluded there")
-    missing, first = uncovered_boundary(r_lo, r_hi, b_lo, b_hi, geometry)
-    if missing:
-        ax, v, centre = first
-        raise Refused(f"{missing} cells of the region's boundary lie on no barrier box, the first on rho_{ax + 1} = "
-                      f"{v} around {centre}")
+    _require_covered(r_lo, r_hi, b_lo, b_hi, geometry)
     facts = {"signature": sig, "cell": claim.get("cell"), "others": cells}
     return (f"cell {claim.get('cell')} and cells {', '.join(map(str, cells))} ({count} solutions) lie in different "
             f"components of the joint box minus g(S): {len(r_lo)} region boxes with the patterns of the cell's "
