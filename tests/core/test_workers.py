@@ -9,7 +9,7 @@ import pytest
 
 from intervalkin.core import workers as workers_module
 from intervalkin.core.geometry import default_geometry
-from intervalkin.core.workers import Workers, owned_rows
+from intervalkin.core.workers import Beside, Workers, owned_rows
 from intervalkin.space.joint_paving import pave_joint_space
 
 
@@ -39,6 +39,25 @@ def test_run_keeps_the_order_and_uses_a_second_process():
     assert len(out) == len(parts) > 1
     assert np.array_equal(np.concatenate([o for o, _ in out]), x * x)
     assert out[0][1] == os.getpid() and any(pid != os.getpid() for _, pid in out)
+
+
+def _fails(message: str) -> None:
+    raise KeyError(message)
+
+
+def test_beside_computes_in_a_second_process_and_passes_errors_on(monkeypatch):
+    x = np.arange(1000.0)
+    with Beside(_square_and_pid, x) as side:
+        square, pid = side.result()
+        assert side.result()[1] == pid  # asked twice: the same answer, not a second wait
+    assert np.array_equal(square, x * x)
+    assert pid != os.getpid()
+    with Beside(_fails, "no such cell") as side, pytest.raises(KeyError, match="no such cell"):
+        side.result()
+    # where no second process may run, the call is made here, when its result is asked for
+    monkeypatch.setattr(workers_module, "default_workers", lambda: 1)
+    with Beside(_square_and_pid, x) as side:
+        assert side.result()[1] == os.getpid()
 
 
 def test_bad_worker_counts_are_refused():

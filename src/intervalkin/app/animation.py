@@ -22,11 +22,12 @@ illustrate a certified motion; the certificate is in the JSON, not in them.
 
 from __future__ import annotations
 
+import io
 import math
-import tempfile
 from pathlib import Path
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from intervalkin.app.palette import colour_of
 from intervalkin.app.plotting import base_points, draw_base_points, legend_outside, new_figure, pyplot, save_png
@@ -43,6 +44,9 @@ __all__ = ['render_trajectory', 'write_trajectory']
 
 #: Resolution of the trajectory figures and frames.
 _DPI = 110
+#: Resolution and frame rate of the animation.
+_GIF_DPI = 80
+_FPS = 12
 
 
 def _platform(geometry: Geometry, pose: np.ndarray):
@@ -221,39 +225,52 @@ def _render_animation(traj: Trajectory, geometry: Geometry, out: Path, frames: i
     yl = (allpts[:, 1].min() - pad, allpts[:, 1].max() + pad)
 
     fig, ax = plt.subplots(figsize=(6, 6))
+    # the static parts are drawn once and the moving artists updated in place: clearing and redrawing the
+    # axes for each frame cost about three times as much
+    base = _platform(geometry, poses[0])[0]
+    ax.plot(s[:, 0], s[:, 1], color="0.7", lw=1)
+    ax.plot(base[:, 0], base[:, 1], "ks", ms=6)
+    legs = [ax.plot([], [], color="0.3", lw=2)[0] for _ in range(3)]
+    body = ax.fill([0, 0, 0], [0, 0, 0], color="#1f77b4" if traj.sign > 0 else "#d62728", alpha=0.5)[0]
+    edge = ax.plot([], [], color="k", lw=1)[0]
+    ax.set_xlim(*xl)
+    ax.set_ylim(*yl)
+    ax.set_aspect("equal")
+    ax.set_xlabel(WORKSPACE_AXES[0], fontsize=8)
+    ax.set_ylabel(WORKSPACE_AXES[1], fontsize=8)
+    title = ax.set_title("", fontsize=9)
 
     def draw(k):
-        ax.clear()
-        base, plat = _platform(geometry, poses[k])
-        for i in range(3):
-            ax.plot([base[i, 0], plat[i, 0]], [base[i, 1], plat[i, 1]], color="0.3", lw=2)
+        plat = _platform(geometry, poses[k])[1]
+        for i, leg in enumerate(legs):
+            leg.set_data([base[i, 0], plat[i, 0]], [base[i, 1], plat[i, 1]])
         tri = np.vstack([plat, plat[:1]])
-        ax.fill(tri[:, 0], tri[:, 1], color="#1f77b4" if traj.sign > 0 else "#d62728", alpha=0.5)
-        ax.plot(tri[:, 0], tri[:, 1], color="k", lw=1)
-        ax.plot(base[:, 0], base[:, 1], "ks", ms=6)
-        ax.plot(s[:, 0], s[:, 1], color="0.7", lw=1)
-        ax.set_xlim(*xl)
-        ax.set_ylim(*yl)
-        ax.set_aspect("equal")
-        ax.set_xlabel(WORKSPACE_AXES[0], fontsize=8)
-        ax.set_ylabel(WORKSPACE_AXES[1], fontsize=8)
-        ax.set_title(f"solution {traj.i_from} -> {traj.i_to} ({traj.aspect}), frame {k + 1}/{len(poses)}", fontsize=9)
+        body.set_xy(tri)
+        edge.set_data(tri[:, 0], tri[:, 1])
+        title.set_text(f"solution {traj.i_from} -> {traj.i_to} ({traj.aspect}), frame {k + 1}/{len(poses)}")
+        return [*legs, body, edge, title]
 
     written: list[Path] = []
     try:
-        import PIL  # noqa: F401
-
-        have_pillow = True
+        from PIL import Image
     except ImportError:  # pragma: no cover - Pillow ships with matplotlib in practice
-        have_pillow = False
-    if have_pillow:
-        from matplotlib.animation import FuncAnimation, PillowWriter
-
-        anim = FuncAnimation(fig, draw, frames=len(poses))
-        with tempfile.TemporaryDirectory() as scratch:  # Pillow writes to a named file
-            gif = Path(scratch) / "trajectory_animation.gif"
-            anim.save(gif, writer=PillowWriter(fps=12), dpi=80)
-            written.append(atomic_write_bytes(out / "trajectory_animation.gif", gif.read_bytes()))
+        Image = None
+    if Image is not None:
+        # blitting: the static background is rendered once, each frame redraws only the moving artists on it
+        # (matplotlib's animation writers render every frame twice, in full)
+        canvas = FigureCanvasAgg(fig)
+        fig.set_dpi(_GIF_DPI)
+        canvas.draw()
+        background = canvas.copy_from_bbox(fig.bbox)
+        images = []
+        for k in range(len(poses)):
+            canvas.restore_region(background)
+            for artist in draw(k):
+                ax.draw_artist(artist)
+            images.append(Image.fromarray(np.asarray(canvas.buffer_rgba())[..., :3].copy()))
+        gif = io.BytesIO()
+        images[0].save(gif, format="GIF", save_all=True, append_images=images[1:], duration=1000 // _FPS, loop=0)
+        written.append(atomic_write_bytes(out / "trajectory_animation.gif", gif.getvalue()))
     else:
         folder = out / "trajectory_frames"
         folder.mkdir(exist_ok=True)

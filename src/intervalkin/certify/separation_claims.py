@@ -38,7 +38,7 @@ from scipy.sparse.csgraph import connected_components
 from intervalkin.certify.pattern_barriers import PatternBarrier, centre, flood, merged_paving, solution_pattern
 from intervalkin.certify.solve_claims import witness_end
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.workers import Workers, default_workers
+from intervalkin.core.workers import Beside, Workers, default_workers
 from intervalkin.paving.adjacency import shares_face
 from intervalkin.paving.tree import box_bounds
 from intervalkin.recheck.arc_pattern import MAX_COUNT, box_arcs, pack
@@ -249,7 +249,8 @@ def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
     return out, omitted
 
 
-def separation_claims(geometry: Geometry, jp, precision: int = 128) -> tuple[list[dict], dict, list[dict]]:
+def separation_claims(geometry: Geometry, jp, precision: int = 128,
+                      patterned: Beside | None = None) -> tuple[list[dict], dict, list[dict]]:
     """(claims, npz arrays, omitted) of ``certificates/joint_separation.json`` and ``.npz``.
 
     Claim j: ``cell``, ``signature``, ``witness`` and ``others`` (each a witness object with its
@@ -258,10 +259,13 @@ def separation_claims(geometry: Geometry, jp, precision: int = 128) -> tuple[lis
     have ``barrier_box`` -1; a pattern barrier (``"kind": "pattern"``) ties each barrier row to the region
     row it lies on (``barrier_box``, an index into all region rows) and to the box beyond it
     (``barrier_outer_lo`` / ``_hi``), and lists the pattern set of each region row (``pattern_box``, rows of
-    ``pattern_rows``: sorted arc starts padded with -2)."""
+    ``pattern_rows``: sorted arc starts padded with -2).
+
+    ``patterned``: :func:`pattern_barriers` of the same paving, already started in a second process (a
+    :class:`~intervalkin.core.workers.Beside`), so that its serial flood runs while this process does the rest."""
     with Workers(default_workers(), min_items=MIN_PART) as workers:
         barriers, omitted = count_barriers(jp, geometry, workers=workers)
-    patterned, left = pattern_barriers(jp, geometry, precision)
+    made, left = patterned.result() if patterned is not None else pattern_barriers(jp, geometry, precision)
     omitted += left
     claims: list[dict] = []
     arrays = {k: [] for k in _COLUMNS}
@@ -306,7 +310,7 @@ def separation_claims(geometry: Geometry, jp, precision: int = 128) -> tuple[lis
         })
         add((bar.region_lo, bar.region_hi), (bar.barrier_lo, bar.barrier_hi), np.full(len(bar.barrier_lo), -1),
             (bar.barrier_lo, bar.barrier_hi), [], j)
-    for witness, others, bar, cell, sig in patterned:
+    for witness, others, bar, cell, sig in made:
         j = len(claims)
         claims.append({
             "id": f"cell-{cell}",

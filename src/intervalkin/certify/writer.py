@@ -127,6 +127,7 @@ with the reason (it is never written as if it held).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 from pathlib import Path
 from typing import Sequence
@@ -135,7 +136,7 @@ import numpy as np
 
 from intervalkin.certify.aspect_claims import aspect_connected_claims
 from intervalkin.certify.joint_claims import joint_claims
-from intervalkin.certify.separation_claims import separation_claims
+from intervalkin.certify.separation_claims import pattern_barriers, separation_claims
 from intervalkin.certify.solve_claims import (
     dkp_claim,
     joint_cell_claims,
@@ -151,6 +152,7 @@ from intervalkin.checker import FORMAT, INDEX, KINDS, VERSION
 from intervalkin.core.errors import InputError
 from intervalkin.core.files import atomic_write, write_json
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Beside
 from intervalkin.core.version import __version__
 
 #: The count barriers (:mod:`intervalkin.certify.separation_claims`), written beside the claim files.
@@ -219,54 +221,58 @@ def write_certificates(
     files: dict[str, list[dict]] = {}
     omitted: list[dict] = []
 
-    dkp_list = []
-    for k, res in enumerate(dkp_results):
-        got, why = dkp_claim(geometry, res, f"q-{k}", precision)
-        (dkp_list.append(got) if got else omitted.append({"what": f"dkp q-{k}", "why": why}))
-    if dkp_list:
-        files["dkp"] = dkp_list
-    if joint is not None:
-        cells, om = joint_cell_claims(geometry, joint, precision)
-        omitted += om
-        files["joint_cell"] = cells
-    pav = regions.paving if regions is not None else paving
-    if pav is not None:
-        asp, om = aspect_distinct_claims(geometry, pav, precision)
-        omitted += om
-        files["aspect_distinct"] = asp
-    if regions is not None:
-        reg, om = region_distinct_claims(geometry, regions, joint, precision)
-        omitted += om
-        files["region_distinct"] = reg
-    if pav is not None and box_sample > 0:
-        files["box_labels"] = [box_labels_claim(pav, box_sample, seed, precision)]
-    if trajectories:
-        trj, om = trajectory_claims(geometry, trajectories, precision)
-        omitted += om
-        files["trajectory"] = trj
-    if aspect_topology is not None:
-        conn, om = aspect_connected_claims(aspect_topology)
-        omitted += om
-        files["aspect_connected"] = conn
-    if joint_cells is not None:
-        models, joins, om = joint_claims(geometry, joint_cells, precision)
-        omitted += om
-        if models:
-            files["joint_fold_model"] = models
-        if joins:
-            files["joint_join"] = joins
-    if regions is not None:
-        aspect_refs = [f"aspect_distinct.json#{c['id']}" for c in files.get("aspect_distinct", [])]
-        aspect_refs += [f"aspect_connected.json#{c['id']}" for c in files.get("aspect_connected", [])]
-        # the counts lean on exactly the solves the library counted from (the joint cells' witnesses): an
-        # extra solve (Table 1's) could prove a larger bound than the count printed beside it
-        solve_refs = [f"joint_cell.json#{c['id']}" for c in files.get("joint_cell", [])]
-        if counts is None and aspect_topology is not None:
-            counts = regions.counts()
-            counts = dataclasses.replace(counts, aspects=aspect_topology.count(counts.aspects))
-        files["counts"] = counts_claims(regions, aspect_refs, solve_refs, counts)
+    wanted = joint_cells is not None and separations
+    with contextlib.ExitStack() as stack:
+        # the pattern floods are serial: a second process runs them while this one proves the other claims
+        side = stack.enter_context(Beside(pattern_barriers, joint_cells, geometry, precision)) if wanted else None
+        dkp_list = []
+        for k, res in enumerate(dkp_results):
+            got, why = dkp_claim(geometry, res, f"q-{k}", precision)
+            (dkp_list.append(got) if got else omitted.append({"what": f"dkp q-{k}", "why": why}))
+        if dkp_list:
+            files["dkp"] = dkp_list
+        if joint is not None:
+            cells, om = joint_cell_claims(geometry, joint, precision)
+            omitted += om
+            files["joint_cell"] = cells
+        pav = regions.paving if regions is not None else paving
+        if pav is not None:
+            asp, om = aspect_distinct_claims(geometry, pav, precision)
+            omitted += om
+            files["aspect_distinct"] = asp
+        if regions is not None:
+            reg, om = region_distinct_claims(geometry, regions, joint, precision)
+            omitted += om
+            files["region_distinct"] = reg
+        if pav is not None and box_sample > 0:
+            files["box_labels"] = [box_labels_claim(pav, box_sample, seed, precision)]
+        if trajectories:
+            trj, om = trajectory_claims(geometry, trajectories, precision)
+            omitted += om
+            files["trajectory"] = trj
+        if aspect_topology is not None:
+            conn, om = aspect_connected_claims(aspect_topology)
+            omitted += om
+            files["aspect_connected"] = conn
+        if joint_cells is not None:
+            models, joins, om = joint_claims(geometry, joint_cells, precision)
+            omitted += om
+            if models:
+                files["joint_fold_model"] = models
+            if joins:
+                files["joint_join"] = joins
+        if regions is not None:
+            aspect_refs = [f"aspect_distinct.json#{c['id']}" for c in files.get("aspect_distinct", [])]
+            aspect_refs += [f"aspect_connected.json#{c['id']}" for c in files.get("aspect_connected", [])]
+            # the counts lean on exactly the solves the library counted from (the joint cells' witnesses): an
+            # extra solve (Table 1's) could prove a larger bound than the count printed beside it
+            solve_refs = [f"joint_cell.json#{c['id']}" for c in files.get("joint_cell", [])]
+            if counts is None and aspect_topology is not None:
+                counts = regions.counts()
+                counts = dataclasses.replace(counts, aspects=aspect_topology.count(counts.aspects))
+            files["counts"] = counts_claims(regions, aspect_refs, solve_refs, counts)
 
-    barriers = separation_claims(geometry, joint_cells, precision) if joint_cells is not None and separations else None
+        barriers = separation_claims(geometry, joint_cells, precision, patterned=side) if wanted else None
     if barriers is not None:
         omitted += barriers[2]
 

@@ -23,7 +23,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-__all__ = ["Workers", "default_workers", "owned_rows", "one_blas_thread", "MIN_PARALLEL_ITEMS"]
+__all__ = ["Workers", "Beside", "default_workers", "owned_rows", "one_blas_thread", "MIN_PARALLEL_ITEMS"]
 
 #: Calls on fewer items than this run in this process (a part must outweigh the cost of shipping it).
 MIN_PARALLEL_ITEMS = 20000
@@ -132,3 +132,66 @@ class Workers:
             for f in futures:
                 f.cancel()
             raise
+
+
+class Beside:
+    """``fn(*args)`` computed in a second process while this one goes on; :meth:`result` waits for it.
+
+    For independent stages that are each serial: the second core takes one while this process does the
+    others.  The process is forked, so ``fn`` and its arguments (a paving of a million boxes) are shared,
+    not pickled; only the result comes back through a pipe.  It is daemonic (it dies with this process),
+    so ``fn`` runs there on one process (:func:`default_workers` is 1).  Where no second process may be
+    started (one core, a daemonic caller, no fork), ``fn`` runs here, at the first call of :meth:`result`.
+    An exception of ``fn`` is raised by :meth:`result` either way.  Use as a context manager: leaving the
+    block stops the process if it still runs.
+    """
+
+    def __init__(self, fn: Callable[..., Any], *args: Any):
+        self._fn, self._args = fn, args
+        self._proc = None
+        self._recv = None
+        self._got: tuple[bool, Any] | None = None
+        if default_workers() > 1 and "fork" in multiprocessing.get_all_start_methods():
+            ctx = multiprocessing.get_context("fork")
+            self._recv, send = ctx.Pipe(duplex=False)
+            self._proc = ctx.Process(target=_send_result, args=(send, fn, args), daemon=True)
+            self._proc.start()
+            send.close()
+
+    def __enter__(self) -> "Beside":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._proc is not None:
+            if self._proc.is_alive():
+                self._proc.terminate()
+            self._proc.join()
+            self._recv.close()
+            self._proc = None
+
+    def result(self) -> Any:
+        if self._proc is None:
+            return self._fn(*self._args)
+        if self._got is None:
+            try:
+                self._got = self._recv.recv()
+            except EOFError:
+                self._proc.join()
+                raise RuntimeError(f"the second process computing {self._fn.__name__} ended without a result "
+                                   f"(exit code {self._proc.exitcode})") from None
+        ok, value = self._got
+        if not ok:
+            raise value
+        return value
+
+
+def _send_result(send, fn: Callable[..., Any], args: tuple) -> None:
+    try:
+        out = (True, _limited(fn, args))
+    except BaseException as exc:  # sent back whole, to be raised by the caller
+        out = (False, exc)
+    try:
+        send.send(out)
+    except Exception as exc:  # an unpicklable exception: its text still reaches the caller
+        send.send((False, RuntimeError(f"{type(out[1]).__name__}: {out[1]} ({exc})")))
+    send.close()
