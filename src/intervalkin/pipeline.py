@@ -42,6 +42,7 @@ from intervalkin.core.errors import InputError
 from intervalkin.core.exact import fraction_bounds
 from intervalkin.core.geometry import Geometry, default_geometry
 from intervalkin.core.status import Status
+from intervalkin.core.workers import Beside
 from intervalkin.paving.budget import check_depth
 from intervalkin.recheck import recheck_folder, recheck_separations
 from intervalkin.solve import dkp
@@ -405,7 +406,9 @@ def verify(path: str | Path) -> VerifyReport:
     """
     root = Path(path)
     folder = root / "certificates" if (root / "certificates" / INDEX).is_file() else root
-    results = tuple(verify_directory(folder))
-    everything = recheck_folder(root)
-    barriers = tuple(recheck_separations(root))
+    # the separation claims (a serial pattern check among them) are re-proved in a second process meanwhile
+    with Beside(recheck_separations, root) as side:
+        results = tuple(verify_directory(folder))
+        everything = recheck_folder(root)
+        barriers = tuple(side.result())
     return VerifyReport(folder, results + barriers + (() if everything is None else (everything,)))
