@@ -183,3 +183,31 @@ def test_seam_crossings_are_found_and_placed_on_the_seam():
     assert a[2] == math.pi and b[2] == -math.pi and a[0] == b[0]
     assert 3.0 < a[0] < 5.0  # interpolated between the samples around the jump
     assert seam_crossings(path[:4]) == []
+
+
+def test_the_animation_moves_the_platform_over_a_fixed_background(tmp_path):
+    """The GIF has one frame per requested pose; the platform moves from frame to frame, while the base
+    points, the path and the axes (the background rendered once) stay where they are."""
+    from types import SimpleNamespace
+
+    from PIL import Image
+
+    from intervalkin.app.animation import _render_animation
+
+    t = np.linspace(0.0, 1.0, 200)
+    path = np.stack([10 + 3 * np.cos(6 * t), 5 + 3 * np.sin(6 * t), 2 * t - 1], axis=1)
+    traj = SimpleNamespace(samples=path, i_from=2, i_to=3, aspect="WA1", sign=1)
+    (gif,) = _render_animation(traj, default_geometry(), tmp_path, 12)
+    im = Image.open(gif)
+    assert im.n_frames == 12
+    frames = []
+    for k in (0, 6, 11):
+        im.seek(k)
+        frames.append(np.asarray(im.convert("RGB"), dtype=np.int16))
+    # the GIF palette is chosen per frame: a fixed pixel may change by a few units of colour, a moved one by far more
+    diff = [np.abs(frames[0] - f).sum(axis=2) for f in frames[1:]]
+    assert all((d > 48).mean() > 0.002 for d in diff)  # the platform and its legs moved
+    # the frame's border (ticks, labels, outside the axes; the title is at the top) is the same in every frame
+    border = np.zeros(diff[0].shape, dtype=bool)
+    border[-40:, :] = border[:, :40] = True
+    assert max(int(d[border].max()) for d in diff) <= 24
