@@ -360,10 +360,15 @@ def _centre_offsets(k: KinematicConstants, b: np.ndarray):
     return Interval.point(xm) - k.ax_iv[0], Interval.point(ym) - k.ay_iv[0], x - xm, y - ym
 
 
-def _det_q(geometry: Geometry, b: np.ndarray):
-    """(Q enclosure, coefficients over phi, slope dQ/dphi over the box) with Q = det A / 8."""
+def _det_q(geometry: Geometry, b: np.ndarray, enclose: bool = True):
+    """(Q enclosure, coefficients over phi, slope dQ/dphi over the box) with Q = det A / 8.
+
+    With ``enclose=False`` the enclosure of Q is not computed (None) and the phi ranges are sampled
+    without the faces phi_lo and phi_hi, which only the enclosure uses: the coefficients' ranges and
+    the slope are the same floats either way (hulls over the same pieces), at about two thirds of the cost.
+    """
     k = constants(geometry)
-    ph = _phi_ranges(b, DET_PHI_PIECES)
+    ph = _phi_ranges(b, DET_PHI_PIECES, ends=enclose)
     co = _det_coefficients_over(k, ph)
     Xm, Ym, U, V = _centre_offsets(k, b)
     squares = (U.sqr(), U * V, V.sqr())
@@ -372,6 +377,8 @@ def _det_q(geometry: Geometry, b: np.ndarray):
         return _taylor([c.box(name) for c in co], Xm, Ym, U, V, *squares)
 
     slope = form("slope")
+    if not enclose:
+        return None, co, slope
     q = form("value") if ph.thin else _phi_tight(form, slope, ph.offset)
     return q, co, slope
 
@@ -393,7 +400,7 @@ def det_a_gradient_interval(geometry: Geometry, boxes: np.ndarray) -> Interval:
     """
     b = _boxes(boxes)
     k = constants(geometry)
-    _, co, slope = _det_q(geometry, b)
+    _, co, slope = _det_q(geometry, b, enclose=False)
     Xm, Ym, U, V = _centre_offsets(k, b)
     gx, gy = quadratic_gradient([c.box("value") for c in co], Xm + U, Ym + V)
     return _stack([gx, gy, slope], 1) * 8.0
