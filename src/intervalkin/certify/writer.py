@@ -222,9 +222,8 @@ def write_certificates(
     omitted: list[dict] = []
 
     wanted = joint_cells is not None and separations
-    with contextlib.ExitStack() as stack:
-        # the pattern floods are serial: a second process runs them while this one proves the other claims
-        side = stack.enter_context(Beside(pattern_barriers, joint_cells, geometry, precision)) if wanted else None
+    # the pattern floods are serial: a second process runs them while this one proves the other claims
+    with Beside(pattern_barriers, joint_cells, geometry, precision) if wanted else contextlib.nullcontext() as side:
         dkp_list = []
         for k, res in enumerate(dkp_results):
             got, why = dkp_claim(geometry, res, f"q-{k}", precision)

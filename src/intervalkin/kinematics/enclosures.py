@@ -361,12 +361,9 @@ def _centre_offsets(k: KinematicConstants, b: np.ndarray):
 
 
 def _det_q(geometry: Geometry, b: np.ndarray, enclose: bool = True):
-    """(Q enclosure, coefficients over phi, slope dQ/dphi over the box) with Q = det A / 8.
-
-    With ``enclose=False`` the enclosure of Q is not computed (None) and the phi ranges are sampled
-    without the faces phi_lo and phi_hi, which only the enclosure uses: the coefficients' ranges and
-    the slope are the same floats either way (hulls over the same pieces), at about two thirds of the cost.
-    """
+    """(Q enclosure, coefficients over phi, slope dQ/dphi over the box) with Q = det A / 8.  Without
+    ``enclose``, Q is None and the faces phi_lo, phi_hi (which only Q uses) are not sampled: the same
+    coefficients and slope (hulls over the same pieces), for about two thirds of the cost."""
     k = constants(geometry)
     ph = _phi_ranges(b, DET_PHI_PIECES, ends=enclose)
     co = _det_coefficients_over(k, ph)
@@ -377,9 +374,7 @@ def _det_q(geometry: Geometry, b: np.ndarray, enclose: bool = True):
         return _taylor([c.box(name) for c in co], Xm, Ym, U, V, *squares)
 
     slope = form("slope")
-    if not enclose:
-        return None, co, slope
-    q = form("value") if ph.thin else _phi_tight(form, slope, ph.offset)
+    q = None if not enclose else form("value") if ph.thin else _phi_tight(form, slope, ph.offset)
     return q, co, slope
 
 
