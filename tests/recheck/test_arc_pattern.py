@@ -128,3 +128,71 @@ def test_witness_patterns_need_the_arcs_decided():
     assert ap.pattern_of_angles(signs, np.array([ang[2]]), np.array([ang[4]])) is None  # a cut inside
     assert ap.pattern_of_angles(np.zeros(ap.GRID, dtype=np.int8), np.array([1.0]), np.array([1.0])) == (ap.WHOLE,)
     assert ap.unpack(ap.pack([(3, 40), ()])) == [(3, 40), ()]
+
+
+def _faces(geometry, seed: int, n: int):
+    """Random face rectangles (one axis of zero width) of random size, some of them 3-D boxes."""
+    lo, hi, rng = _boxes(geometry, seed, n, widest=0.0)
+    flat = rng.integers(0, 4, n)  # 3: a box, not a face
+    rows = np.flatnonzero(flat < 3)
+    hi[rows, flat[rows]] = lo[rows, flat[rows]]
+    return lo, hi, rng
+
+
+def test_split_exclusions_hold_the_solver_counts(geometry):
+    """Fact 4 of the lemma: where split_excludes proves a face free of a count, the solver never finds that count
+    at random points of it; and the splits prove more than the whole face alone."""
+    k = reduced_constants(geometry)
+    lo, hi, rng = _faces(geometry, 31, 30)
+    excluded = {c: ap.split_excludes(k, lo, hi, c) for c in (0, 2, 4, 6)}
+    whole = {c: ap.split_excludes(k, lo, hi, c, splits=(1,)) for c in (0, 2, 4, 6)}
+    for c in excluded:
+        assert np.all(excluded[c] | ~whole[c])  # splitting never loses what the whole face proves
+    assert sum(int(np.sum(excluded[c] & ~whole[c])) for c in excluded) > 0
+    checked = 0
+    for i in range(lo.shape[0]):
+        for _ in range(3):
+            got = _solve(geometry, rng.uniform(lo[i], hi[i]))
+            if got is None:
+                continue
+            assert not excluded[got[0].size][i], (i, lo[i], hi[i], got[0].size)
+            checked += 1
+    assert checked > 60
+    assert sum(int(v.sum()) for v in excluded.values()) > 30  # the exclusions are not vacuous
+
+
+def test_the_split_parts_cover_the_face(paper_geometry, monkeypatch):
+    """The parts whose count ranges are computed cover the face: every random point of it lies in one part (in
+    the squared leg lengths, where the ranges are computed)."""
+    k = reduced_constants(paper_geometry)
+    lo, hi, rng = _faces(paper_geometry, 32, 12)
+    seen = []
+    real = ap.arc_ranges
+
+    def spy(k_, r_lo, r_hi, box, a, b, pieces=1, depth=7):
+        seen.append((r_lo.copy(), r_hi.copy()))
+        return real(k_, r_lo, r_hi, box, a, b, pieces, depth)
+
+    monkeypatch.setattr(ap, "arc_ranges", spy)
+    for i in range(lo.shape[0]):
+        seen.clear()
+        ap.split_excludes(k, lo[i][None], hi[i][None], 7, splits=(4,))  # 7 is never excluded: every part is kept
+        r_lo = np.concatenate([s[0] for s in seen])
+        r_hi = np.concatenate([s[1] for s in seen])
+        assert r_lo.shape[0] == 4 ** int(np.sum(hi[i] > lo[i]))
+        corners = rng.uniform(lo[i], hi[i], (50, 3))
+        corners[:4] = [lo[i], hi[i], np.where([1, 0, 1], lo[i], hi[i]), np.where([0, 1, 0], lo[i], hi[i])]
+        for q in corners:
+            assert np.any(np.all((r_lo <= q * q) & (q * q <= r_hi), axis=1)), (i, q)
+
+
+def test_a_relation_is_emptied_only_where_proved(paper_geometry):
+    k = reduced_constants(paper_geometry)
+    lo, hi, _ = _faces(paper_geometry, 33, 16)
+    ex = ap.split_excludes(k, lo, hi, 2)
+    assert ex.any() and not ex.all()
+    rels = [{((1, 2), (1, 2))} for _ in range(lo.shape[0])]
+    asked = np.arange(0, lo.shape[0], 2)
+    out = ap.prune_relations(k, lo, hi, rels, 2, asked)
+    for i in range(lo.shape[0]):
+        assert out[i] == (set() if (ex[i] and i % 2 == 0) else rels[i])

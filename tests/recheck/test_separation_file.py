@@ -261,3 +261,13 @@ def test_a_folder_with_a_pattern_barrier_verifies_and_a_torn_tie_is_refused(ever
     np.savez(tmp_path / ARRAYS, **torn)
     got = recheck_separations(tmp_path)[j]
     assert not got.verified and "barrier_box" in got.message
+
+
+def test_the_walls_rest_on_their_count_proofs(patterned, paper_geometry, monkeypatch):
+    """The flood walls faces of clear boxes of another count where split count ranges prove them free of the
+    count (fact 4 of the lemma); the claim needs those proofs: with them taken away the checker refuses it."""
+    import intervalkin.recheck.separation_file as sf
+    claim, (region, patterns, barrier, box, outer) = patterned
+    monkeypatch.setattr(sf, "prune_relations", lambda k, f_lo, f_hi, rels, count, which: rels)
+    with pytest.raises(Refused, match="not excluded there|may meet"):
+        check_pattern_separation(paper_geometry, claim, region, patterns, barrier, box, outer)

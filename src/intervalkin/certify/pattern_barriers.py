@@ -34,7 +34,7 @@ from fractions import Fraction
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.recheck.arc_pattern import FIELDS, BoxArcs, box_arcs, face_relations, pattern_of_angles
+from intervalkin.recheck.arc_pattern import FIELDS, BoxArcs, box_arcs, face_relations, pattern_of_angles, prune_relations
 from intervalkin.recheck.reduced_equation import reduced_constants
 
 __all__ = ["FACE_BUDGET", "RIVAL_BOXES", "PatternBarrier", "flood", "solution_pattern", "merged_paving", "centre"]
@@ -73,12 +73,16 @@ def solution_pattern(arcs: BoxArcs, row: int, witness: dict) -> tuple[int, ...] 
 
 def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: np.ndarray, count: int,
           start: tuple[int, tuple], forbidden: dict[int, set],
-          rivals: np.ndarray | None = None, budget: int = FACE_BUDGET) -> tuple[PatternBarrier | None, str, int]:
+          rivals: np.ndarray | None = None, budget: int = FACE_BUDGET,
+          walls: np.ndarray | None = None) -> tuple[PatternBarrier | None, str, int]:
     """The pattern barrier grown from ``start`` = (leaf, pattern) over boxes [lo, hi] with face contacts (a, b),
     or None; why not; the number of faces related.  ``forbidden``: leaf -> patterns that must not be reached
     (other witnesses).
     ``rivals``: boxes of other cells of the signature; a flood that gives patterns to more than :data:`RIVAL_BOXES`
-    of them is leaking into another cell and is given up (a choice of effort: the lemma does not need it)."""
+    of them is leaking into another cell and is given up (a choice of effort: the lemma does not need it).
+    ``walls`` (n,) bool: boxes (a clear box of a cell with another count, say) whose faces the flood crosses only
+    where split count ranges do not prove the face free of ``count`` solutions
+    (:func:`~intervalkin.recheck.arc_pattern.prune_relations`); a face costs its count ranges again when tested."""
     k = reduced_constants(geometry)
     rivals = np.zeros(0, dtype=np.int64) if rivals is None else rivals
     n = len(lo)
@@ -95,6 +99,8 @@ def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: 
     found[leaf0] = {pat0}
     frontier = [leaf0]
     table = None
+    # faces of wall boxes whose count ranges are not yet tested: tested only when the flood would cross them
+    untested = np.zeros(a.size, dtype=bool) if walls is None else walls[a] | walls[b]
     while frontier:
         fl = np.array(sorted(frontier), dtype=np.int64)
         inc = np.concatenate([np.arange(ptr[x], ptr[x + 1]) for x in fl])
@@ -112,21 +118,29 @@ def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: 
             f_lo, f_hi = np.maximum(lo[a[new]], lo[b[new]]), np.minimum(hi[a[new]], hi[b[new]])
             got = face_relations(k, f_lo, f_hi, table.take(row[a[new]]), table.take(row[b[new]]), count)
             rel.update(zip(new.tolist(), got))
-        nxt = set()
+        nxt, ask = set(), set()
         for x in fl.tolist():
             mine = found.setdefault(x, set())
             for j in range(ptr[x], ptr[x + 1]):
                 f, y = int(face[j]), int(other[j])
                 theirs = found.setdefault(y, set())
                 first = a[f] == x
-                for pa, pb in rel[f]:
-                    u, v = (pa, pb) if first else (pb, pa)
-                    if u in mine and v not in theirs:
-                        theirs.add(v)
-                        nxt.add(y)
-                    if v in theirs and u not in mine:
-                        mine.add(u)
-                        nxt.add(x)
+                crossing = [((pa, pb) if first else (pb, pa)) for pa, pb in rel[f]]
+                crossing = [(u, v) for u, v in crossing if (u in mine) != (v in theirs)]
+                if crossing and untested[f]:
+                    ask.add(f)  # all of this round's at once, below; x comes back to cross it if it stays open
+                    nxt.add(x)
+                    continue
+                for u, v in crossing:
+                    theirs.add(v)
+                    mine.add(u)
+                    nxt.update((x, y))
+        if ask:
+            f = np.array(sorted(ask), dtype=np.int64)
+            f_lo, f_hi = np.maximum(lo[a[f]], lo[b[f]]), np.minimum(hi[a[f]], hi[b[f]])
+            got = prune_relations(k, f_lo, f_hi, [rel[t] for t in f.tolist()], count, np.arange(f.size))
+            rel.update(zip(f.tolist(), got))
+            untested[f] = False
         if rivals.size and sum(1 for x in rivals.tolist() if found.get(x)) > RIVAL_BOXES:
             return None, ("its patterns reach boxes of another cell of its signature (the face relations there do "
                           "not tell the two apart)"), len(rel)

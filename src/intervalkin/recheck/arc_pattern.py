@@ -32,7 +32,7 @@ from intervalkin.recheck.count_range import NO_BOUND, PIECES, arc_ranges, r_box
 from intervalkin.recheck.reduced_equation import ReducedConstants, d_sign, derivative_enclosures, sign_at_points
 
 __all__ = ["GRID", "WHOLE", "MAX_COUNT", "cut_angles", "cut_signs", "arc_starts", "ArcTable", "arc_table",
-           "BoxArcs", "box_arcs", "face_relations", "pattern_of_angles", "pack", "unpack"]
+           "BoxArcs", "box_arcs", "face_relations", "split_excludes", "prune_relations", "pattern_of_angles", "pack", "unpack"]
 
 #: Fixed candidate cut angles on the circle.
 GRID = 64
@@ -40,8 +40,14 @@ GRID = 64
 WHOLE = -1
 #: Solutions at most (the sextic): the width of a pattern row.
 MAX_COUNT = 6
-#: Pieces each arc starts from in arc_ranges (the whole circle: count_range.PIECES).
-ARC_PIECES = 2
+#: Pieces each arc starts from in arc_ranges, in a box's arcs and over a face (the whole circle:
+#: count_range.PIECES), and halvings of a piece before it is given up.  Next to a fold's near-double root seven
+#: halvings are not enough: the range keeps an upper bound of 4 to 6 where the arcs hold no solution (a thin cell
+#: of the second design), and the flood crosses there.  Starting from 8 pieces instead costs more for the same.
+ARC_PIECES, ARC_DEPTH = 2, 9
+#: Parts per axis of a face whose count ranges may prove that it holds no point of the count
+#: (:func:`split_excludes`), tried in this order.
+SPLITS = (1, 2, 4)
 
 
 def cut_angles(grid: int = GRID) -> np.ndarray:
@@ -57,6 +63,11 @@ def cut_signs(k: ReducedConstants, q_lo: np.ndarray, q_hi: np.ndarray, grid: int
     ang = np.tile(cut_angles(grid), n)
     s = sign_at_points(k, np.repeat(r_lo, grid, axis=0), np.repeat(r_hi, grid, axis=0), ang, ang)
     return s.reshape(n, grid)
+
+
+def _arc_ranges(k: ReducedConstants, r_lo: np.ndarray, r_hi: np.ndarray, box: np.ndarray, a: np.ndarray,
+                b: np.ndarray):
+    return arc_ranges(k, r_lo, r_hi, box, a, b, ARC_PIECES, ARC_DEPTH)
 
 
 def arc_starts(mask: np.ndarray) -> np.ndarray:
@@ -123,7 +134,7 @@ def arc_table(k: ReducedConstants, q_lo: np.ndarray, q_hi: np.ndarray, signs: np
     p_arc = np.concatenate([rest, rest[r_wrap]])
     p_a = np.concatenate([ang[start[rest]], np.full(int(r_wrap.sum()), -np.pi)])
     p_b = np.concatenate([np.where(r_wrap, np.pi, ang[end[rest]]), ang[end[rest[r_wrap]]]])
-    rng = arc_ranges(k, r_lo, r_hi, owner[p_arc], p_a, p_b, ARC_PIECES)
+    rng = _arc_ranges(k, r_lo, r_hi, owner[p_arc], p_a, p_b)
     np.add.at(lo, p_arc, rng.lo)
     np.add.at(hi, p_arc, rng.hi)
     d_lo = np.where(p_a <= -PI_LO, -PI_HI, p_a)
@@ -251,7 +262,7 @@ def face_relations(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, a: B
         p_arc = np.concatenate([look, look[wraps]])
         p_a = np.concatenate([ang[start[look]], np.full(int(wraps.sum()), -np.pi)])
         p_b = np.concatenate([np.where(wraps, np.pi, ang[end[look]]), ang[end[look][wraps]]])
-        rng = arc_ranges(k, r_lo, r_hi, face[p_arc], p_a, p_b, 1)
+        rng = _arc_ranges(k, r_lo, r_hi, face[p_arc], p_a, p_b)
         f_lo_c, f_hi_c = np.zeros(face.size, dtype=np.int64), np.zeros(face.size, dtype=np.int64)
         np.add.at(f_lo_c, p_arc, rng.lo)
         np.add.at(f_hi_c, p_arc, rng.hi)
@@ -285,6 +296,57 @@ def face_relations(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, a: B
             units = np.repeat(st, v)
             pairs.add((tuple(sorted(_map(to_a[i], units))), tuple(sorted(_map(to_b[i], units)))))
         out.append(pairs)
+    return out
+
+
+def split_excludes(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, count: int,
+                   splits: tuple[int, ...] = SPLITS) -> np.ndarray:
+    """(m,) bool: PROVED that no point of box [f_lo[i], f_hi[i]] (a face rectangle or a box) has ``count``
+    solutions: for some s of ``splits``, the box cut into s equal parts along each axis of positive width has
+    the count range of every part (:func:`~intervalkin.recheck.count_range.arc_ranges` over the whole circle,
+    ``lemma-count-range.md``) excluding ``count``.  The parts share their float end points and the outer ones
+    end at the box's own, so they cover it exactly.  Such a face's relation is empty
+    (proofs/lemma-pattern-barrier.md, fact 4): a large box of a cell with another count, whose arcs are too
+    coarse to say so, is walled this way."""
+    f_lo, f_hi = np.atleast_2d(f_lo), np.atleast_2d(f_hi)
+    m = f_lo.shape[0]
+    out = np.zeros(m, dtype=bool)
+    free = f_hi > f_lo
+    for s in splits:
+        for shape in np.unique(free[~out], axis=0):
+            rows = np.flatnonzero(~out & np.all(free == shape, axis=1))
+            if rows.size == 0:
+                continue
+            parts = [s if shape[d] else 1 for d in range(3)]
+            edges = []
+            for d in range(3):
+                e = f_lo[rows, d, None] + (f_hi[rows, d] - f_lo[rows, d])[:, None] * (np.arange(parts[d] + 1) / parts[d])[None, :]
+                e[:, 0], e[:, -1] = f_lo[rows, d], f_hi[rows, d]
+                edges.append(np.maximum.accumulate(np.minimum(e, f_hi[rows, d, None]), axis=1))
+            idx = np.stack(np.meshgrid(*(np.arange(p) for p in parts), indexing="ij"), axis=-1).reshape(-1, 3)
+            p_lo = np.stack([edges[d][:, idx[:, d]] for d in range(3)], axis=-1).reshape(-1, 3)
+            p_hi = np.stack([edges[d][:, idx[:, d] + 1] for d in range(3)], axis=-1).reshape(-1, 3)
+            owner = np.repeat(np.arange(rows.size), idx.shape[0])
+            r_lo, r_hi = r_box(p_lo, p_hi)
+            n = p_lo.shape[0]
+            got = arc_ranges(k, r_lo, r_hi, np.arange(n), np.full(n, -np.pi), np.full(n, np.pi), PIECES)
+            hit = np.ones(rows.size, dtype=bool)
+            np.logical_and.at(hit, owner, (count < got.lo) | (count > got.hi))
+            out[rows[hit]] = True
+    return out
+
+
+def prune_relations(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, relations: list[set], count: int,
+                    which: np.ndarray) -> list[set]:
+    """``relations`` with those of the faces ``which`` (indices) emptied where :func:`split_excludes` proves the
+    face holds no point of ``count`` solutions; the others as they are.  The builder asks for the faces its
+    flood should not cross, the checker for those a claim needs walled; both prove the same way."""
+    which = np.asarray(which, dtype=np.int64)
+    which = which[[bool(relations[i]) for i in which.tolist()]] if which.size else which
+    out = list(relations)
+    if which.size:
+        for i in which[split_excludes(k, f_lo[which], f_hi[which], count)].tolist():
+            out[i] = set()
     return out
 
 

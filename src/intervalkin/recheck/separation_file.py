@@ -41,7 +41,8 @@ from intervalkin.core.errors import CertificateFormatError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers, default_workers
 from intervalkin.recheck.arith import fraction_enclosure
-from intervalkin.recheck.arc_pattern import MAX_COUNT, box_arcs, face_relations, pattern_of_angles, unpack
+from intervalkin.recheck.arc_pattern import (MAX_COUNT, box_arcs, face_relations, pattern_of_angles,
+                                             prune_relations, unpack)
 from intervalkin.recheck.count_range import count_ranges, supported
 from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.recheck.paving_file import folder_geometry
@@ -259,15 +260,23 @@ def check_pattern_separation(geometry: Geometry, claim: dict, region: tuple[np.n
     pi, pj = face_pairs(r_lo, r_hi)
     if pi.size:
         f_lo, f_hi = np.maximum(r_lo[pi], r_lo[pj]), np.minimum(r_hi[pi], r_hi[pj])
-        for t, rel in enumerate(face_relations(k, f_lo, f_hi, arcs.take(pi), arcs.take(pj), count)):
+        rels = face_relations(k, f_lo, f_hi, arcs.take(pi), arcs.take(pj), count)
+        torn = [t for t, rel in enumerate(rels)
+                if any((u in patterns[int(pi[t])]) != (v in patterns[int(pj[t])]) for u, v in rel)]
+        # a face the claim needs walled may still hold no point of the count at all (lemma, fact 4)
+        rels = prune_relations(k, f_lo, f_hi, rels, count, np.array(torn, dtype=np.int64))
+        for t in torn:
             i, j = int(pi[t]), int(pj[t])
-            for u, v in rel:
+            for u, v in rels[t]:
                 if (u in patterns[i]) != (v in patterns[j]):
                     raise Refused(f"region boxes {i} and {j}: on their shared face pattern {list(u)} of one and "
                                   f"{list(v)} of the other may meet, and only one is in its box's set")
     if b_lo.size:
         rel = face_relations(k, b_lo, b_hi, arcs.take(barrier_box), box_arcs(k, o_lo, o_hi), count)
-        for t, pairs in enumerate(rel):
+        open_ = [t for t, pairs in enumerate(rel) if any(u in patterns[int(barrier_box[t])] for u, _ in pairs)]
+        rel = prune_relations(k, b_lo, b_hi, rel, count, np.array(open_, dtype=np.int64))
+        for t in open_:
+            pairs = rel[t]
             own = patterns[int(barrier_box[t])]
             if any(u in own for u, _ in pairs):
                 raise Refused(f"barrier box {t} [{b_lo[t].tolist()}, {b_hi[t].tolist()}]: a pattern of its region "
