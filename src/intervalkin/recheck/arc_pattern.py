@@ -41,10 +41,14 @@ WHOLE = -1
 #: Solutions at most (the sextic): the width of a pattern row.
 MAX_COUNT = 6
 #: Pieces each arc starts from in arc_ranges, in a box's arcs and over a face (the whole circle:
-#: count_range.PIECES), and halvings of a piece before it is given up.  Next to a fold's near-double root seven
-#: halvings are not enough: the range keeps an upper bound of 4 to 6 where the arcs hold no solution (a thin cell
-#: of the second design), and the flood crosses there.  Starting from 8 pieces instead costs more for the same.
-ARC_PIECES, ARC_DEPTH = 2, 9
+#: count_range.PIECES).
+ARC_PIECES = 2
+#: Halvings of a piece of a face's own arc ranges (a box's arcs take count_range.DEPTH, 7).  Next to a fold's
+#: near-double root seven are not enough: the range keeps an upper bound of 4 to 6 where the arc holds no
+#: solution (a thin cell of the second design) and the flood crosses there.  Only the arcs neither box decides
+#: are ranged over the face, so the deeper bisection costs little there; in every box's arcs it would cost a
+#: third more.
+FACE_DEPTH = 9
 #: Parts per axis of a face whose count ranges may prove that it holds no point of the count
 #: (:func:`split_excludes`), tried in this order.
 SPLITS = (1, 2, 4)
@@ -63,11 +67,6 @@ def cut_signs(k: ReducedConstants, q_lo: np.ndarray, q_hi: np.ndarray, grid: int
     ang = np.tile(cut_angles(grid), n)
     s = sign_at_points(k, np.repeat(r_lo, grid, axis=0), np.repeat(r_hi, grid, axis=0), ang, ang)
     return s.reshape(n, grid)
-
-
-def _arc_ranges(k: ReducedConstants, r_lo: np.ndarray, r_hi: np.ndarray, box: np.ndarray, a: np.ndarray,
-                b: np.ndarray):
-    return arc_ranges(k, r_lo, r_hi, box, a, b, ARC_PIECES, ARC_DEPTH)
 
 
 def arc_starts(mask: np.ndarray) -> np.ndarray:
@@ -134,7 +133,7 @@ def arc_table(k: ReducedConstants, q_lo: np.ndarray, q_hi: np.ndarray, signs: np
     p_arc = np.concatenate([rest, rest[r_wrap]])
     p_a = np.concatenate([ang[start[rest]], np.full(int(r_wrap.sum()), -np.pi)])
     p_b = np.concatenate([np.where(r_wrap, np.pi, ang[end[rest]]), ang[end[rest[r_wrap]]]])
-    rng = _arc_ranges(k, r_lo, r_hi, owner[p_arc], p_a, p_b)
+    rng = arc_ranges(k, r_lo, r_hi, owner[p_arc], p_a, p_b, ARC_PIECES)
     np.add.at(lo, p_arc, rng.lo)
     np.add.at(hi, p_arc, rng.hi)
     d_lo = np.where(p_a <= -PI_LO, -PI_HI, p_a)
@@ -262,7 +261,7 @@ def face_relations(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, a: B
         p_arc = np.concatenate([look, look[wraps]])
         p_a = np.concatenate([ang[start[look]], np.full(int(wraps.sum()), -np.pi)])
         p_b = np.concatenate([np.where(wraps, np.pi, ang[end[look]]), ang[end[look][wraps]]])
-        rng = _arc_ranges(k, r_lo, r_hi, face[p_arc], p_a, p_b)
+        rng = arc_ranges(k, r_lo, r_hi, face[p_arc], p_a, p_b, ARC_PIECES, FACE_DEPTH)
         f_lo_c, f_hi_c = np.zeros(face.size, dtype=np.int64), np.zeros(face.size, dtype=np.int64)
         np.add.at(f_lo_c, p_arc, rng.lo)
         np.add.at(f_hi_c, p_arc, rng.hi)
