@@ -143,7 +143,7 @@ def test_split_exclusions_hold_the_solver_counts(geometry):
     """Fact 4 of the lemma: where split_excludes proves a face free of a count, the solver never finds that count
     at random points of it; and the splits prove more than the whole face alone."""
     k = reduced_constants(geometry)
-    lo, hi, rng = _faces(geometry, 31, 30)
+    lo, hi, rng = _faces(geometry, 31, 20)
     excluded = {c: ap.split_excludes(k, lo, hi, c) for c in (0, 2, 4, 6)}
     whole = {c: ap.split_excludes(k, lo, hi, c, splits=(1,)) for c in (0, 2, 4, 6)}
     for c in excluded:
@@ -157,8 +157,8 @@ def test_split_exclusions_hold_the_solver_counts(geometry):
                 continue
             assert not excluded[got[0].size][i], (i, lo[i], hi[i], got[0].size)
             checked += 1
-    assert checked > 60
-    assert sum(int(v.sum()) for v in excluded.values()) > 30  # the exclusions are not vacuous
+    assert checked > 40
+    assert sum(int(v.sum()) for v in excluded.values()) > 20  # the exclusions are not vacuous
 
 
 def test_the_split_parts_cover_the_face(paper_geometry, monkeypatch):
