@@ -32,7 +32,7 @@ from intervalkin.recheck.count_range import NO_BOUND, PIECES, arc_ranges, r_box
 from intervalkin.recheck.reduced_equation import ReducedConstants, d_sign, derivative_enclosures, sign_at_points
 
 __all__ = ["GRID", "WHOLE", "MAX_COUNT", "cut_angles", "cut_signs", "arc_starts", "ArcTable", "arc_table",
-           "BoxArcs", "box_arcs", "face_relations", "split_excludes", "prune_relations", "pattern_of_angles", "pack", "unpack"]
+           "BoxArcs", "box_arcs", "face_relations", "count_bounds", "split_excludes", "prune_relations", "pattern_of_angles", "pack", "unpack"]
 
 #: Fixed candidate cut angles on the circle.
 GRID = 64
@@ -299,12 +299,23 @@ def face_relations(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, a: B
     return out
 
 
+def count_bounds(arcs: BoxArcs) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi) per box: its number of solutions at every point, the sums of its arcs' ranges (no solution sits at
+    a cut, so the arcs share them out), or the whole circle's range for a box without cuts.  Tighter than one
+    range over the whole circle next to a fold, where the arcs bisect the roots apart one by one."""
+    cut = arcs.signs != 0
+    lo = np.where(cut, arcs.lo, 0).sum(axis=1)
+    hi = np.where(cut, np.minimum(arcs.hi, NO_BOUND), 0).sum(axis=1)
+    none = ~cut.any(axis=1)
+    return np.where(none, arcs.whole_lo, lo), np.where(none, arcs.whole_hi, hi)
+
+
 def split_excludes(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, count: int,
                    splits: tuple[int, ...] = SPLITS) -> np.ndarray:
     """(m,) bool: PROVED that no point of box [f_lo[i], f_hi[i]] (a face rectangle or a box) has ``count``
     solutions: for some s of ``splits``, the box cut into s equal parts along each axis of positive width has
-    the count range of every part (:func:`~intervalkin.recheck.count_range.arc_ranges` over the whole circle,
-    ``lemma-count-range.md``) excluding ``count``.  The parts share their float end points and the outer ones
+    the count range of every part (:func:`count_bounds`: the sum of its arcs' ranges, ``lemma-count-range.md``)
+    excluding ``count``.  The parts share their float end points and the outer ones
     end at the box's own, so they cover it exactly.  Such a face's relation is empty
     (proofs/lemma-pattern-barrier.md, fact 4): a large box of a cell with another count, whose arcs are too
     coarse to say so, is walled this way."""
@@ -327,11 +338,9 @@ def split_excludes(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, coun
             p_lo = np.stack([edges[d][:, idx[:, d]] for d in range(3)], axis=-1).reshape(-1, 3)
             p_hi = np.stack([edges[d][:, idx[:, d] + 1] for d in range(3)], axis=-1).reshape(-1, 3)
             owner = np.repeat(np.arange(rows.size), idx.shape[0])
-            r_lo, r_hi = r_box(p_lo, p_hi)
-            n = p_lo.shape[0]
-            got = arc_ranges(k, r_lo, r_hi, np.arange(n), np.full(n, -np.pi), np.full(n, np.pi), PIECES)
+            lo_n, hi_n = count_bounds(box_arcs(k, p_lo, p_hi))
             hit = np.ones(rows.size, dtype=bool)
-            np.logical_and.at(hit, owner, (count < got.lo) | (count > got.hi))
+            np.logical_and.at(hit, owner, (count < lo_n) | (count > hi_n))
             out[rows[hit]] = True
     return out
 
