@@ -196,3 +196,16 @@ def test_a_relation_is_emptied_only_where_proved(paper_geometry):
     out = ap.prune_relations(k, lo, hi, rels, 2, asked)
     for i in range(lo.shape[0]):
         assert out[i] == (set() if (ex[i] and i % 2 == 0) else rels[i])
+
+
+def test_a_box_decided_on_every_grid_step_has_arcs(paper_geometry):
+    """A face of the paper's joint box far from any solution has a proved sign of f at all 64 cut angles and on
+    every grid step between them: its arcs need no range at all (an empty batch of ranges), and hold 0 in all."""
+    k = reduced_constants(paper_geometry)
+    lo = np.array([[11.378621838068574, 30.01777620911349, 11.492347852607775]])
+    hi = np.array([[11.525605478069442, 30.12774828358213, 11.492347852607775]])
+    arcs = ap.box_arcs(k, lo, hi)
+    assert np.all(arcs.signs != 0)
+    low, high = ap.count_bounds(arcs)
+    assert low.tolist() == [0] and high.tolist() == [0]
+    assert ap.split_excludes(k, lo, hi, 2).all()

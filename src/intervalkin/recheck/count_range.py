@@ -188,6 +188,8 @@ def arc_ranges(k: ReducedConstants, r_lo: np.ndarray, r_hi: np.ndarray, box: np.
     Consecutive pieces of one arc on which the same derivative order has the same sign are taken as one
     *run* (the sign holds on the union of closed pieces), and Rolle's bound is applied to the run."""
     m = box.size
+    if m == 0:  # a batch of boxes whose every arc was decided without a range (no solution on any grid step)
+        return CountRanges(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
     owner, lo_phi, hi_phi, order, sign, s_lo, s_hi, failed = _pieces(k, r_lo, r_hi, box, a, b, pieces, depth)
     # f has the sign of a d = 0 piece at both of its ends
     s_lo = np.where(order == 0, sign, s_lo)
