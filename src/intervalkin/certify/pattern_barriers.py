@@ -21,7 +21,9 @@ other witness, so those lie in other components (proofs/lemma-pattern-barrier.md
 verify`` re-proves all of it from the files (:mod:`intervalkin.recheck.separation_file`).
 
 How the region is found (effort, not soundness): a flood over the leaves of the joint paving from the
-witness's (leaf, pattern), following the face relations both ways until nothing new is reached.  It
+witness's (leaf, pattern), following the face relations both ways until nothing new is reached.  Before it
+crosses a face of a clear box of a cell with another count, it asks whether split count ranges prove the
+face free of its count (the lemma's fact 4): large clear boxes have arcs too coarse to say so.  It
 stops, and the cell stays library-proved only, when it reaches another witness's (leaf, pattern) or
 spends :data:`FACE_BUDGET` faces.
 """
@@ -34,7 +36,8 @@ from fractions import Fraction
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.recheck.arc_pattern import FIELDS, BoxArcs, box_arcs, face_relations, pattern_of_angles, prune_relations
+from intervalkin.recheck.arc_pattern import (FIELDS, BoxArcs, box_arcs, face_relations, pattern_of_angles,
+                                             prune_relations)
 from intervalkin.recheck.reduced_equation import reduced_constants
 
 __all__ = ["FACE_BUDGET", "RIVAL_BOXES", "PatternBarrier", "flood", "solution_pattern", "merged_paving", "centre"]

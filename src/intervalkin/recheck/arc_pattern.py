@@ -32,7 +32,8 @@ from intervalkin.recheck.count_range import NO_BOUND, PIECES, arc_ranges, r_box
 from intervalkin.recheck.reduced_equation import ReducedConstants, d_sign, derivative_enclosures, sign_at_points
 
 __all__ = ["GRID", "WHOLE", "MAX_COUNT", "cut_angles", "cut_signs", "arc_starts", "ArcTable", "arc_table",
-           "BoxArcs", "box_arcs", "face_relations", "count_bounds", "split_excludes", "prune_relations", "pattern_of_angles", "pack", "unpack"]
+           "BoxArcs", "box_arcs", "face_relations", "count_bounds", "split_excludes", "prune_relations",
+           "pattern_of_angles", "pack", "unpack"]
 
 #: Fixed candidate cut angles on the circle.
 GRID = 64
@@ -315,10 +316,9 @@ def split_excludes(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, coun
     """(m,) bool: PROVED that no point of box [f_lo[i], f_hi[i]] (a face rectangle or a box) has ``count``
     solutions: for some s of ``splits``, the box cut into s equal parts along each axis of positive width has
     the count range of every part (:func:`count_bounds`: the sum of its arcs' ranges, ``lemma-count-range.md``)
-    excluding ``count``.  The parts share their float end points and the outer ones
-    end at the box's own, so they cover it exactly.  Such a face's relation is empty
-    (proofs/lemma-pattern-barrier.md, fact 4): a large box of a cell with another count, whose arcs are too
-    coarse to say so, is walled this way."""
+    excluding ``count``.  The parts share their float end points and the outer ones end at the box's own, so
+    they cover it exactly.  Such a face's relation is empty (proofs/lemma-pattern-barrier.md, fact 4): a face of
+    a large box of a cell with another count, whose arcs are too coarse to say so, is walled this way."""
     f_lo, f_hi = np.atleast_2d(f_lo), np.atleast_2d(f_hi)
     m = f_lo.shape[0]
     out = np.zeros(m, dtype=bool)
@@ -331,7 +331,8 @@ def split_excludes(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, coun
             parts = [s if shape[d] else 1 for d in range(3)]
             edges = []
             for d in range(3):
-                e = f_lo[rows, d, None] + (f_hi[rows, d] - f_lo[rows, d])[:, None] * (np.arange(parts[d] + 1) / parts[d])[None, :]
+                t = np.arange(parts[d] + 1) / parts[d]
+                e = f_lo[rows, d, None] + (f_hi[rows, d] - f_lo[rows, d])[:, None] * t[None, :]
                 e[:, 0], e[:, -1] = f_lo[rows, d], f_hi[rows, d]
                 edges.append(np.maximum.accumulate(np.minimum(e, f_hi[rows, d, None]), axis=1))
             idx = np.stack(np.meshgrid(*(np.arange(p) for p in parts), indexing="ij"), axis=-1).reshape(-1, 3)
