@@ -63,8 +63,9 @@ SHRINK = 0.6
 SAMPLE, MAX_FAIL_SHARE = 200, 0.35
 #: Faces worth sending to a second process at once.
 MIN_PART = 400
-#: Faces a pattern barrier's flood may relate, and all of one paving's floods (2 ms each on the paper's paving,
-#: up to 12 ms where faces are walled by split count ranges): the second design's first barrier needs 12 800.
+#: Faces a pattern barrier's flood may relate, and all of one paving's floods (about 5 ms each on the paper's
+#: paving, 8 ms on the second design's, where many are walled by split count ranges): the second design's first
+#: barrier relates 12 204.
 PATTERN_BUDGET, TOTAL_PATTERN_BUDGET = 16000, 16000
 #: Faces a flood relates per box of its cell, at least: the floods that closed related 17 to 22 (a region holds
 #: its whole cell and spreads to about five times its boxes; a box has six faces, more where the paving is finer).
