@@ -220,6 +220,15 @@ def _solution_phi(witness: dict) -> tuple[np.ndarray, np.ndarray]:
     return np.array([b[2][0] for b in boxes], dtype=np.float64), np.array([b[2][1] for b in boxes], dtype=np.float64)
 
 
+def _unwalled(k, f_lo: np.ndarray, f_hi: np.ndarray, rels: list[set], count: int, bad) -> tuple | None:
+    """The first face t with a pair (u, v) of its relation for which ``bad(t, u, v)`` holds, and that pair, after
+    the faces with such pairs that split count ranges prove free of ``count`` solutions get the empty relation
+    (lemma, fact 4); None when no face is left."""
+    failing = np.array([t for t, rel in enumerate(rels) if any(bad(t, u, v) for u, v in rel)], dtype=np.int64)
+    rels = prune_relations(k, f_lo, f_hi, rels, count, failing)
+    return next(((int(t), (u, v)) for t in failing.tolist() for u, v in rels[t] if bad(t, u, v)), None)
+
+
 def check_pattern_separation(geometry: Geometry, claim: dict, region: tuple[np.ndarray, np.ndarray],
                              patterns: list[set], barrier: tuple[np.ndarray, np.ndarray], barrier_box: np.ndarray,
                              outer: tuple[np.ndarray, np.ndarray]) -> tuple[str, dict]:
@@ -261,26 +270,19 @@ def check_pattern_separation(geometry: Geometry, claim: dict, region: tuple[np.n
     if pi.size:
         f_lo, f_hi = np.maximum(r_lo[pi], r_lo[pj]), np.minimum(r_hi[pi], r_hi[pj])
         rels = face_relations(k, f_lo, f_hi, arcs.take(pi), arcs.take(pj), count)
-        torn = [t for t, rel in enumerate(rels)
-                if any((u in patterns[int(pi[t])]) != (v in patterns[int(pj[t])]) for u, v in rel)]
-        # a face the claim needs walled may still hold no point of the count at all (lemma, fact 4)
-        rels = prune_relations(k, f_lo, f_hi, rels, count, np.array(torn, dtype=np.int64))
-        for t in torn:
-            i, j = int(pi[t]), int(pj[t])
-            for u, v in rels[t]:
-                if (u in patterns[i]) != (v in patterns[j]):
-                    raise Refused(f"region boxes {i} and {j}: on their shared face pattern {list(u)} of one and "
-                                  f"{list(v)} of the other may meet, and only one is in its box's set")
+        torn = _unwalled(k, f_lo, f_hi, rels, count,
+                         lambda t, u, v: (u in patterns[int(pi[t])]) != (v in patterns[int(pj[t])]))
+        if torn is not None:
+            t, (u, v) = torn
+            raise Refused(f"region boxes {int(pi[t])} and {int(pj[t])}: on their shared face pattern {list(u)} of one "
+                          f"and {list(v)} of the other may meet, and only one is in its box's set")
     if b_lo.size:
         rel = face_relations(k, b_lo, b_hi, arcs.take(barrier_box), box_arcs(k, o_lo, o_hi), count)
-        open_ = [t for t, pairs in enumerate(rel) if any(u in patterns[int(barrier_box[t])] for u, _ in pairs)]
-        rel = prune_relations(k, b_lo, b_hi, rel, count, np.array(open_, dtype=np.int64))
-        for t in open_:
-            pairs = rel[t]
-            own = patterns[int(barrier_box[t])]
-            if any(u in own for u, _ in pairs):
-                raise Refused(f"barrier box {t} [{b_lo[t].tolist()}, {b_hi[t].tolist()}]: a pattern of its region "
-                              "box's set is not excluded there")
+        open_ = _unwalled(k, b_lo, b_hi, rel, count, lambda t, u, v: u in patterns[int(barrier_box[t])])
+        if open_ is not None:
+            t = open_[0]
+            raise Refused(f"barrier box {t} [{b_lo[t].tolist()}, {b_hi[t].tolist()}]: a pattern of its region "
+                          "box's set is not excluded there")
     _require_covered(r_lo, r_hi, b_lo, b_hi, geometry)
     facts = {"signature": sig, "cell": claim.get("cell"), "others": cells}
     return (f"cell {claim.get('cell')} and cells {', '.join(map(str, cells))} ({count} solutions) lie in different "
