@@ -119,6 +119,27 @@ def test_face_relations_hold_the_patterns_of_points(geometry):
     assert checked > 80
 
 
+def test_own_patterns_hold_the_solver_patterns(geometry):
+    """Fact 5 of the lemma: the pattern the solver's solutions take at a point of a box is among the box's own
+    patterns of that count, so a face's relation lies in the product of its boxes' own sets.  Most sampled boxes
+    allow one pattern, which is what lets the flood and the checker skip most faces."""
+    arcs, seen = _samples(geometry, seed=24, n=30, per_box=2)
+    own = {c: ap.own_patterns(arcs, c) for c in range(0, 7, 2)}
+    single = 0
+    for i, counts, total in seen:
+        pattern = tuple(sorted(s for s, c in counts.items() for _ in range(c)))
+        if not (arcs.signs[i] != 0).any():
+            pattern = (ap.WHOLE,) * total
+        assert pattern in own[total][i], (i, pattern, own[total][i])
+        single += len(own[total][i]) == 1
+        for other in own:
+            if other != total and (arcs.signs[i] != 0).any():
+                # a count the arcs' sums exclude leaves no pattern
+                lo, hi = ap.count_bounds(arcs.take(np.array([i])))
+                assert bool(own[other][i]) <= bool(lo[0] <= other <= hi[0])
+    assert len(seen) > 40 and single > len(seen) // 2
+
+
 def test_witness_patterns_need_the_arcs_decided():
     signs = np.zeros(ap.GRID, dtype=np.int8)
     signs[[3, 40]] = 1

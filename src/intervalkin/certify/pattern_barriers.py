@@ -23,9 +23,12 @@ verify`` re-proves all of it from the files (:mod:`intervalkin.recheck.separatio
 How the region is found (effort, not soundness): a flood over the leaves of the joint paving from the
 witness's (leaf, pattern), following the face relations both ways until nothing new is reached.  Before it
 crosses a face of a clear box of a cell with another count, it asks whether split count ranges prove the
-face free of its count (the lemma's fact 4): large clear boxes have arcs too coarse to say so.  It
-stops, and the cell stays library-proved only, when it reaches another witness's (leaf, pattern) or
-spends :data:`FACE_BUDGET` faces.
+face free of its count (the lemma's fact 4): large clear boxes have arcs too coarse to say so.  A face
+starts with the product of its boxes' own pattern sets (fact 5) and is ranged only when that product would
+carry a pattern across it, once no face with a final relation moves anything: the flood first runs through
+the faces that need no range (between boxes labelled clear with its count, allowing one pattern each), and
+most faces it would have ranged then have both sides reached.  It stops, and the cell stays library-proved
+only, when it reaches another witness's (leaf, pattern) or would range more than :data:`FACE_BUDGET` faces.
 """
 
 from __future__ import annotations
@@ -36,13 +39,13 @@ from fractions import Fraction
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.recheck.arc_pattern import (FIELDS, BoxArcs, box_arcs, face_relations, pattern_of_angles,
-                                             prune_relations)
+from intervalkin.recheck.arc_pattern import (FIELDS, BoxArcs, box_arcs, face_relations, own_patterns,
+                                             pattern_of_angles, prune_relations)
 from intervalkin.recheck.reduced_equation import reduced_constants
 
 __all__ = ["FACE_BUDGET", "RIVAL_BOXES", "PatternBarrier", "flood", "solution_pattern", "merged_paving", "centre"]
 
-#: Faces whose relation a flood may compute before it is given up (about 1.5 ms each, plus the boxes).
+#: Faces a flood may range (about 2 ms each on the paper's paving, plus the boxes' arcs, about 6 ms each).
 FACE_BUDGET = 20000
 #: Boxes of other cells of the signature a flood may reach before it is given up (a successful flood on the paper's
 #: manipulator reaches none; one that leaks reaches hundreds).
@@ -77,7 +80,7 @@ def solution_pattern(arcs: BoxArcs, row: int, witness: dict) -> tuple[int, ...] 
 def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: np.ndarray, count: int,
           start: tuple[int, tuple], forbidden: dict[int, set],
           rivals: np.ndarray | None = None, budget: int = FACE_BUDGET,
-          walls: np.ndarray | None = None) -> tuple[PatternBarrier | None, str, int]:
+          walls: np.ndarray | None = None, same: np.ndarray | None = None) -> tuple[PatternBarrier | None, str, int]:
     """The pattern barrier grown from ``start`` = (leaf, pattern) over boxes [lo, hi] with face contacts (a, b),
     or None; why not; the number of faces related.  ``forbidden``: leaf -> patterns that must not be reached
     (other witnesses).
@@ -85,7 +88,11 @@ def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: 
     of them is leaking into another cell and is given up (a choice of effort: the lemma does not need it).
     ``walls`` (n,) bool: boxes (a clear box of a cell with another count, say) whose faces the flood crosses only
     where split count ranges do not prove the face free of ``count`` solutions
-    (:func:`~intervalkin.recheck.arc_pattern.prune_relations`); a face costs its count ranges again when tested."""
+    (:func:`~intervalkin.recheck.arc_pattern.prune_relations`); a face costs its count ranges again when tested.
+    ``same`` (n,) bool: boxes the library labels clear with ``count`` solutions.  A face between two of them whose
+    own pattern sets (:func:`~intervalkin.recheck.arc_pattern.own_patterns`) are one pattern each takes that pair
+    as its relation without ranging the face (the pair is all the lemma's fact 5 allows; the labels only say
+    where ranging would not make it smaller), and a face whose own sets leave no pair gets the empty relation."""
     k = reduced_constants(geometry)
     rivals = np.zeros(0, dtype=np.int64) if rivals is None else rivals
     n = len(lo)
@@ -96,12 +103,16 @@ def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: 
     ends, other, face = ends[at], other[at], face[at]
     ptr = np.searchsorted(ends, np.arange(n + 1))
     row = np.full(n, -1, dtype=np.int64)
-    rel: dict[int, set] = {}
+    owns: list[frozenset] = []  # per table row: the patterns of `count` its own arcs allow
+    same = np.zeros(n, dtype=bool) if same is None else same
+    rel: dict[int, set] = {}  # faces whose relation is final: ranged, or needing no range (see _relations)
+    cand: dict[int, set] = {}  # faces holding only the product of their boxes' own sets, not yet ranged
     found: dict[int, set] = {}
     leaf0, pat0 = start
     found[leaf0] = {pat0}
     frontier = [leaf0]
     table = None
+    ranged = 0
     # faces of wall boxes whose count ranges are not yet tested: tested only when the flood would cross them
     untested = np.zeros(a.size, dtype=bool) if walls is None else walls[a] | walls[b]
     while frontier:
@@ -113,32 +124,42 @@ def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: 
             row[need] = np.arange(need.size) + (0 if table is None else table.signs.shape[0])
             fresh = box_arcs(k, lo[need], hi[need])
             table = fresh if table is None else _stack([table, fresh])
+            owns += own_patterns(fresh, count)
         new = np.unique(face[inc])
-        new = new[[f not in rel for f in new.tolist()]] if new.size else new
-        if len(rel) + new.size > budget:
-            return None, f"more than {budget} faces to relate", len(rel)
+        new = new[[f not in rel and f not in cand for f in new.tolist()]] if new.size else new
         if new.size:
-            f_lo, f_hi = np.maximum(lo[a[new]], lo[b[new]]), np.minimum(hi[a[new]], hi[b[new]])
-            got = face_relations(k, f_lo, f_hi, table.take(row[a[new]]), table.take(row[b[new]]), count)
-            rel.update(zip(new.tolist(), got))
-        nxt, ask = set(), set()
+            final, product = _relations(a[new], b[new], new, row, owns, same)
+            rel.update(final)
+            cand.update(product)
+        # a face without its range is crossed only once nothing else moves: by then the boxes on both sides
+        # have often been reached through faces needing none, and it needs none either
+        nxt, ask, queue, moved = set(), set(), set(), False
         for x in fl.tolist():
             mine = found.setdefault(x, set())
             for j in range(ptr[x], ptr[x + 1]):
                 f, y = int(face[j]), int(other[j])
                 theirs = found.setdefault(y, set())
                 first = a[f] == x
-                crossing = [((pa, pb) if first else (pb, pa)) for pa, pb in rel[f]]
+                crossing = [((pa, pb) if first else (pb, pa)) for pa, pb in (rel[f] if f in rel else cand[f])]
                 crossing = [(u, v) for u, v in crossing if (u in mine) != (v in theirs)]
-                if crossing and untested[f]:
-                    ask.add(f)  # all of this round's at once, below; x comes back to cross it if it stays open
+                if crossing and (f not in rel or untested[f]):
+                    (ask if f in rel else queue).add(f)  # all at once, below; x comes back to cross it
                     nxt.add(x)
                     continue
                 for u, v in crossing:
                     theirs.add(v)
                     mine.add(u)
                     nxt.update((x, y))
-        if ask:
+                    moved = True
+        if queue and not moved:
+            if ranged + len(queue) > budget:
+                return None, f"more than {budget} faces to relate", ranged
+            f = np.array(sorted(queue), dtype=np.int64)
+            rel.update(_ranged(k, lo, hi, a[f], b[f], f, row, owns, table, count))
+            for t in f.tolist():
+                del cand[t]
+            ranged += f.size
+        if ask and not moved:
             f = np.array(sorted(ask), dtype=np.int64)
             f_lo, f_hi = np.maximum(lo[a[f]], lo[b[f]]), np.minimum(hi[a[f]], hi[b[f]])
             got = prune_relations(k, f_lo, f_hi, [rel[t] for t in f.tolist()], count, np.arange(f.size))
@@ -146,23 +167,55 @@ def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: 
             untested[f] = False
         if rivals.size and sum(1 for x in rivals.tolist() if found.get(x)) > RIVAL_BOXES:
             return None, ("its patterns reach boxes of another cell of its signature (the face relations there do "
-                          "not tell the two apart)"), len(rel)
+                          "not tell the two apart)"), ranged
         for leaf, pats in forbidden.items():
             if found.get(leaf, set()) & pats:
-                return None, "its patterns reach another cell's witness (a finer paving would be needed)", len(rel)
+                return None, "its patterns reach another cell's witness (a finer paving would be needed)", ranged
         frontier = sorted(nxt)
     leaves = np.array(sorted(x for x, p in found.items() if p), dtype=np.int64)
     inside = np.zeros(n, dtype=bool)
     inside[leaves] = True
     region_row = np.full(n, -1, dtype=np.int64)
     region_row[leaves] = np.arange(leaves.size)
-    edge = np.array(sorted(f for f in rel if inside[a[f]] != inside[b[f]]), dtype=np.int64)
+    edge = np.array(sorted(f for f in (*rel, *cand) if inside[a[f]] != inside[b[f]]), dtype=np.int64)
     inner_end = np.where(inside[a[edge]], a[edge], b[edge]) if edge.size else edge
     outer_end = np.where(inside[a[edge]], b[edge], a[edge]) if edge.size else edge
     return PatternBarrier(
         leaves, lo[leaves], hi[leaves], tuple(tuple(sorted(found[x])) for x in leaves.tolist()),
         np.maximum(lo[a[edge]], lo[b[edge]]), np.minimum(hi[a[edge]], hi[b[edge]]), region_row[inner_end],
-        lo[outer_end], hi[outer_end]), "", len(rel)
+        lo[outer_end], hi[outer_end]), "", ranged
+
+
+def _relations(fa: np.ndarray, fb: np.ndarray, faces: np.ndarray, row: np.ndarray, owns: list[frozenset],
+               same: np.ndarray) -> tuple[dict[int, set], dict[int, set]]:
+    """(relations needing no range, the others' products) of faces ``faces`` between boxes fa[i] and fb[i].  A face
+    whose boxes' own pattern sets leave no pair has the empty relation; one between two boxes labelled clear with
+    the flood's count (``same``) whose own sets are one pattern each has that pair (ranging could only empty it,
+    and a face of two such boxes holds points of the count).  Each relation is within the product (fact 5 of the
+    lemma), so the labels bear on the flood's effort only."""
+    final, product = {}, {}
+    for f, x, y in zip(faces.tolist(), fa.tolist(), fb.tolist()):
+        pa, pb = owns[row[x]], owns[row[y]]
+        if not pa or not pb:
+            final[f] = set()
+        elif len(pa) == 1 and len(pb) == 1 and same[x] and same[y]:
+            final[f] = {(next(iter(pa)), next(iter(pb)))}
+        else:
+            product[f] = {(u, v) for u in pa for v in pb}
+    return final, product
+
+
+def _ranged(k, lo: np.ndarray, hi: np.ndarray, fa: np.ndarray, fb: np.ndarray, faces: np.ndarray, row: np.ndarray,
+            owns: list[frozenset], table: BoxArcs, count: int) -> dict[int, set]:
+    """The relations of faces ``faces`` ranged over each face (:func:`face_relations`), within the products of their
+    boxes' own pattern sets."""
+    f_lo, f_hi = np.maximum(lo[fa], lo[fb]), np.minimum(hi[fa], hi[fb])
+    got = face_relations(k, f_lo, f_hi, table.take(row[fa]), table.take(row[fb]), count)
+    out = {}
+    for f, x, y, g in zip(faces.tolist(), fa.tolist(), fb.tolist(), got):
+        pa, pb = owns[row[x]], owns[row[y]]
+        out[f] = {(u, v) for u, v in g if u in pa and v in pb}
+    return out
 
 
 def merged_paving(level: np.ndarray, ijk: np.ndarray, label: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

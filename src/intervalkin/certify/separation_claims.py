@@ -63,14 +63,12 @@ SHRINK = 0.6
 SAMPLE, MAX_FAIL_SHARE = 200, 0.35
 #: Faces worth sending to a second process at once.
 MIN_PART = 400
-#: Faces a pattern barrier's flood may relate, and all of one paving's floods (about 5 ms each on the paper's
-#: paving, 8 ms on the second design's, where many are walled by split count ranges): the second design's first
-#: barrier relates 12 204.
+#: Faces a pattern barrier's flood may range, for one flood and for all of one paving's floods (a face needs a
+#: range only where its boxes' own patterns would carry the flood across it): the second design's first barrier
+#: ranges 9761, the paper's 3042.
 PATTERN_BUDGET, TOTAL_PATTERN_BUDGET = 16000, 16000
-#: Faces a flood relates per box of its cell, at least: the floods that closed related 17 to 22 (a region holds
-#: its whole cell and spreads to about five times its boxes; a box has six faces, more where the paving is finer).
-#: A cell past the budget at this rate is not tried (a 4-solution cell of 1449 boxes spent 9241 faces and 30 s
-#: on a depth-5 paving without closing).
+#: Faces a flood ranges per box of its cell, at least: the floods that closed ranged 9 and 15 (a region holds its
+#: whole cell and spreads to about five times its boxes).  A cell past the budget at this rate is not tried.
 FACES_PER_BOX = 12
 #: The npz columns of ``certificates/joint_separation.npz``.
 _COLUMNS = ("region_lo", "region_hi", "region_claim", "barrier_lo", "barrier_hi", "barrier_claim", "barrier_box",
@@ -250,7 +248,8 @@ def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
             # a clear box of another count is walled where its count ranges say so: its arcs may be too coarse to
             walls = (clear_count >= 0) & (clear_count != sig[0])
             bar, why, used = flood(geometry, lo, hi, a, b, sig[0], (node[c.id], pats[c.id]), forbidden, rivals,
-                                   budget=min(budget, TOTAL_PATTERN_BUDGET - spent), walls=walls)
+                                   budget=min(budget, TOTAL_PATTERN_BUDGET - spent), walls=walls,
+                                   same=clear_count == sig[0])
             spent += used
             if bar is None:
                 omitted.append({"what": f"pattern barrier of cell {c.id} ({sig[0]} solutions)", "why": why})

@@ -32,7 +32,7 @@ from intervalkin.recheck.count_range import NO_BOUND, PIECES, arc_ranges, r_box
 from intervalkin.recheck.reduced_equation import ReducedConstants, d_sign, derivative_enclosures, sign_at_points
 
 __all__ = ["GRID", "WHOLE", "MAX_COUNT", "cut_angles", "cut_signs", "arc_starts", "ArcTable", "arc_table",
-           "BoxArcs", "box_arcs", "face_relations", "count_bounds", "split_excludes", "prune_relations",
+           "BoxArcs", "box_arcs", "own_patterns", "face_relations", "count_bounds", "split_excludes", "prune_relations",
            "pattern_of_angles", "pack", "unpack"]
 
 #: Fixed candidate cut angles on the circle.
@@ -214,6 +214,26 @@ def _vectors(lo: np.ndarray, hi: np.ndarray, parity: np.ndarray, count: int) -> 
         v = lo.copy()
         v[free] += np.array(combo, dtype=np.int64)
         out.append(tuple(int(x) for x in v))
+    return out
+
+
+def own_patterns(arcs: BoxArcs, count: int) -> list[frozenset[tuple[int, ...]]]:
+    """Per box of ``arcs``: every pattern its own arcs allow a point of it off g(S) with ``count`` solutions (the
+    vectors of solutions per arc within the arcs' ranges and parities, summing to ``count``; for a box without
+    cuts, the whole circle's pattern when its range holds ``count``).
+
+    The relation of any face of two boxes lies in the product of their sets (proofs/lemma-pattern-barrier.md,
+    fact 5): a point of the face is a point of both closed boxes, where their ranges hold.  A face whose product is
+    empty, or holds no pair that a barrier's pattern sets would tear, needs no relation of its own."""
+    out = []
+    for i in range(arcs.signs.shape[0]):
+        st = np.flatnonzero(arcs.signs[i] != 0)
+        if st.size == 0:
+            whole = arcs.whole_lo[i] <= count <= arcs.whole_hi[i]
+            out.append(frozenset({(WHOLE,) * count} if whole else ()))
+            continue
+        vec = _vectors(arcs.lo[i, st], arcs.hi[i, st], arcs.parity[i, st], count)
+        out.append(frozenset(tuple(np.repeat(st, v).tolist()) for v in vec))
     return out
 
 

@@ -41,8 +41,8 @@ from intervalkin.core.errors import CertificateFormatError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers, default_workers
 from intervalkin.recheck.arith import fraction_enclosure
-from intervalkin.recheck.arc_pattern import (MAX_COUNT, box_arcs, face_relations, pattern_of_angles,
-                                             prune_relations, unpack)
+from intervalkin.recheck.arc_pattern import (MAX_COUNT, box_arcs, face_relations, own_patterns,
+                                             pattern_of_angles, prune_relations, unpack)
 from intervalkin.recheck.count_range import count_ranges, supported
 from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.recheck.paving_file import folder_geometry
@@ -266,7 +266,13 @@ def check_pattern_separation(geometry: Geometry, claim: dict, region: tuple[np.n
             if got is None or got in patterns[i]:
                 raise Refused(f"others[{n_o}]: its witness may lie in region box {i} with a pattern of its set")
         cells.append(obj.get("cell"))
+    own = own_patterns(arcs, count)
     pi, pj = face_pairs(r_lo, r_hi)
+    n_pairs = pi.size
+    # a face whose boxes' own pattern sets hold no pair the sets would tear needs no relation (fact 5)
+    tears = [any((u in patterns[i]) != (v in patterns[j]) for u in own[i] for v in own[j])
+             for i, j in zip(pi.tolist(), pj.tolist())]
+    pi, pj = pi[tears], pj[tears]
     if pi.size:
         f_lo, f_hi = np.maximum(r_lo[pi], r_lo[pj]), np.minimum(r_hi[pi], r_hi[pj])
         rels = face_relations(k, f_lo, f_hi, arcs.take(pi), arcs.take(pj), count)
@@ -276,18 +282,28 @@ def check_pattern_separation(geometry: Geometry, claim: dict, region: tuple[np.n
             t, (u, v) = torn
             raise Refused(f"region boxes {int(pi[t])} and {int(pj[t])}: on their shared face pattern {list(u)} of one "
                           f"and {list(v)} of the other may meet, and only one is in its box's set")
-    if b_lo.size:
-        rel = face_relations(k, b_lo, b_hi, arcs.take(barrier_box), box_arcs(k, o_lo, o_hi), count)
-        open_ = _unwalled(k, b_lo, b_hi, rel, count, lambda t, u, v: u in patterns[int(barrier_box[t])])
+    # a barrier box on a region box none of whose own patterns is in its set, or beyond which the outer box allows
+    # no pattern of the count, holds no pair starting in the set
+    at = np.flatnonzero([bool(own[i] & patterns[i]) for i in barrier_box.tolist()])
+    if at.size:
+        # boxes beyond the region hold several barrier boxes each: their arcs once
+        outer, which = np.unique(np.hstack([o_lo[at], o_hi[at]]), axis=0, return_inverse=True)
+        which = which.ravel()
+        o_arcs = box_arcs(k, outer[:, :3], outer[:, 3:])
+        at_o = np.array([bool(x) for x in own_patterns(o_arcs, count)], dtype=bool)[which]
+        at, o_arcs = at[at_o], o_arcs.take(which[at_o])
+    if at.size:
+        rel = face_relations(k, b_lo[at], b_hi[at], arcs.take(barrier_box[at]), o_arcs, count)
+        open_ = _unwalled(k, b_lo[at], b_hi[at], rel, count, lambda t, u, v: u in patterns[int(barrier_box[at[t]])])
         if open_ is not None:
-            t = open_[0]
+            t = int(at[open_[0]])
             raise Refused(f"barrier box {t} [{b_lo[t].tolist()}, {b_hi[t].tolist()}]: a pattern of its region "
                           "box's set is not excluded there")
     _require_covered(r_lo, r_hi, b_lo, b_hi, geometry)
     facts = {"signature": sig, "cell": claim.get("cell"), "others": cells}
     return (f"cell {claim.get('cell')} and cells {', '.join(map(str, cells))} ({count} solutions) lie in different "
             f"components of the joint box minus g(S): {len(r_lo)} region boxes with the patterns of the cell's "
-            f"solutions, {pi.size} shared faces related, the boundary covered by {len(b_lo)} boxes where none of "
+            f"solutions, {n_pairs} shared faces ({pi.size} of them ranged), the boundary covered by {len(b_lo)} boxes where none of "
             "those patterns occurs"), facts
 
 
