@@ -161,3 +161,19 @@ def test_markdown_subset():
     assert '<ul>\n<li>one</li>\n<li><a href="t.png">two</a></li>\n</ul>' in out
     assert '<img src="figures/f.png" alt="cap"' in out
     assert links("![cap](figures/f.png) and [t](x/y.md)") == ["figures/f.png", "x/y.md"]
+
+
+def test_open_places_are_reported_with_their_reasons(folder):
+    """The report names why each listed place is open, with the leaves per reason, and the totals by reason."""
+    from intervalkin.app.report_joint import joint_cells_passage
+
+    why = {"cusp_window": {"leaves": 3, "volume": 0.5}, "slope_not_certified": {"leaves": 2, "volume": 0.25}}
+    place = {"lo": [10.0, 10.0, 10.0], "hi": [11.0, 11.0, 11.0], "volume": 0.75, "leaves": 5, "without_model": 0,
+             "on_face": True, "why": why}
+    summary = json.loads(json.dumps(folder[1]))  # a copy
+    summary["joint_cells"]["open_places"] = {"count": 1, "volume_without_model": 0.0, "volume_window_model": 0.75,
+                                             "by_reason": why, "largest": [place]}
+    text = "\n".join(joint_cells_passage(summary, ([10.0] * 3, [32.0] * 3)))
+    assert "By reason: cusp window 3 leaves (0.50); one pair window (slope not certified) 2 leaves (0.25)." in text
+    row = next(line for line in text.splitlines() if line.startswith("| 0.750"))
+    assert row.endswith("| cusp window 3, one pair window (slope not certified) 2 |")

@@ -108,12 +108,27 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
                 f"kind, {places.get('volume_window_model', 0.0):.2f} with a window model (a certified count at each "
                 "point, pieces not proved connected). "
                 "A cell could hide in a place, or two cells meet through one, so no upper bound is proved. "
-                "The largest:\n",
-                "| volume | leaves | without a model | from (rho_1, rho_2, rho_3) | to | on a face |",
-                "|---|---|---|---|---|---|"]
+                + _why_line(places.get("by_reason") or {}) + "The largest:\n",
+                "| volume | leaves | without a model | from (rho_1, rho_2, rho_3) | to | on a face | why (leaves) |",
+                "|---|---|---|---|---|---|---|"]
         for q in places["largest"][:10]:
             out.append(f"| {q['volume']:.3f} | {q['leaves']} | {q['without_model']} | "
                        f"({', '.join(f'{v:.2f}' for v in q['lo'])}) | ({', '.join(f'{v:.2f}' for v in q['hi'])}) | "
-                       f"{'yes' if q['on_face'] else 'no'} |")
+                       f"{'yes' if q['on_face'] else 'no'} | "
+                       + ", ".join(f"{_WHY.get(k, k)} {v['leaves']}" for k, v in (q.get("why") or {}).items()) + " |")
         out.append("")
     return out
+
+
+#: Short names of the reasons a leaf is open (space.joint_places.REASONS), for the report's tables.
+_WHY = {"no_model": "no model", "cusp_window": "cusp window", "window_at_points": "window signs at points only",
+        "pair_windows": "several pair windows", "slope_not_certified": "one pair window (slope not certified)",
+        "fold_piece_count": "fold piece of unknown count", "other": "other"}
+
+
+def _why_line(by_reason: dict) -> str:
+    """One sentence: the open leaves and volume by reason (what a model would have to handle)."""
+    if not by_reason:
+        return ""
+    parts = [f"{_WHY.get(k, k)} {v['leaves']} leaves ({v['volume']:.2f})" for k, v in by_reason.items()]
+    return "By reason: " + "; ".join(parts) + ". "

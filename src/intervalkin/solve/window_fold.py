@@ -48,12 +48,18 @@ from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_count import window_signature
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
-__all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "WindowFolds", "window_folds", "fold_piece", "extreme_corners"]
+__all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced", "fold_piece",
+           "extreme_corners"]
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
 #: What the two roots of a pair window add to a signature (count, n_wa1, n_wa2).
 PAIR = np.array([2, 1, 1], dtype=np.int64)
+#: Why a modelled box is neither window-clear nor a window fold, most telling first (:func:`why_not_pieced`):
+#: a cusp window (one or three roots: a cusp edge of g(S) may pass), a window whose end signs or sign of D
+#: are proved only at points, two pair windows or more (sheets of g(S) that may cross), one pair window whose
+#: slope signs are not certified (a sheet that may turn within the box).
+WHY_NOT = ("cusp_window", "window_at_points", "pair_windows", "slope_not_certified")
 #: Halvings of the critical pieces of a pair window before its slope signs are read.
 CRITICAL_HALVINGS = 1
 
@@ -152,6 +158,24 @@ def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITI
     signature[fold, 0] = base[fold]
     signature[fold, 1] = base[fold] + PAIR
     return WindowFolds(kind, window, rising, signature, edge_rising)
+
+
+def why_not_pieced(models: WindowModels, folds: WindowFolds) -> np.ndarray:
+    """(n,) int8 per box of ``models``: the index in :data:`WHY_NOT` of the first reason its pieces are not proved
+    connected, -1 for window-clear boxes, window folds and boxes without a model.  The classes follow the windows'
+    kinds as :func:`window_folds` reads them (a label for reports, not a claim)."""
+    n = len(models.ok)
+    ends = models.end_signs.astype(np.int64)
+    firm = (ends != 0).all(axis=1) & (models.d_sign != 0)
+    even = firm & (ends[:, 0] == ends[:, 1])
+    box = models.window_box
+    count = [np.bincount(box, weights=w, minlength=n) > t for w, t in (
+        (firm & (models.degree == 3) & ~even, 0), (~firm, 0), (even, 1), (even, 0))]
+    out = np.full(n, -1, dtype=np.int8)
+    for code in range(len(WHY_NOT) - 1, -1, -1):  # the first reason wins
+        out[count[code]] = code
+    out[~models.ok | np.isin(folds.kind, (CLEAR, FOLD))] = -1
+    return out
 
 
 def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: int, pw: np.ndarray,

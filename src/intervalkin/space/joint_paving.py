@@ -63,7 +63,7 @@ from intervalkin.space.joint_leaves import adaptive_leaves, leaves_to_paving, re
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
 from intervalkin.space.joint_models import ModelStore
 from intervalkin.space.joint_pieces import FoldPieces, PieceSignatures, piece_signatures
-from intervalkin.space.joint_places import WHY_OPEN, open_places
+from intervalkin.space.joint_places import WHY_OPEN, leaf_reasons, open_places, why_counts
 from intervalkin.space.joint_window_pieces import (check_window_cells, signatures_from_windows, window_cell_of,
                                                    window_columns, window_pieces)
 from intervalkin.space.joint_windows import JointWindows, window_refinement
@@ -131,14 +131,16 @@ class JointSpacePaving:
         (face-connected groups of open leaves, :mod:`intervalkin.space.joint_places`), the largest listed."""
         fs = self.fold_stats
         open_leaf = (self.cell < 0) & ~self.counted_fold_mask() & ~self.pieced_mask()
-        no_model = self.cell < 0
+        fold = np.zeros(len(self.cell), dtype=bool)
         if self.pieces is not None and len(self.pieces):
-            no_model[self.pieces.box] = False
+            fold[self.pieces.box] = True
         p = self.paving
-        windowed = self.windows.modelled_mask(len(self.cell)) if self.windows is not None else np.zeros_like(no_model)
-        no_model &= ~windowed
+        windowed = self.windows.modelled_mask(len(self.cell)) if self.windows is not None else np.zeros_like(fold)
+        no_model = (self.cell < 0) & ~fold & ~windowed
         windowed &= ~self.pieced_mask()  # open for the counts all the same: a point model proves no pieces
-        n, largest = open_places(p.level, p.ijk, p.lo, p.hi, open_leaf, no_model, p.domain)
+        why = self.windows.why_not_pieced(len(self.cell)) if self.windows is not None else None
+        reason = leaf_reasons(open_leaf, no_model, why, fold)
+        n, largest = open_places(p.level, p.ijk, p.lo, p.hi, open_leaf, no_model, p.domain, reason)
         return {"joint_volume": self.undecided_volume(), "joint_certified_share": self.certified_share(),
                 "fragments": [{"count": c.count, "volume": c.volume, "witness": [str(v) for v in c.witness]}
                               for c in self.fragments],
@@ -148,6 +150,8 @@ class JointSpacePaving:
                            "volume_window_model": float(p.volume()[windowed].sum()),
                            "volume_window_pieces": float(p.volume()[self.pieced_mask()].sum()),
                            "why": WHY_OPEN,
+                           "by_reason": {name: {"leaves": k, "volume": v} for name, k, v in
+                                         why_counts(reason[open_leaf], p.volume()[open_leaf])},
                            "largest": [q.to_json() for q in largest]}}
 
     def pieced_mask(self) -> np.ndarray:

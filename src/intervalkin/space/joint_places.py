@@ -25,8 +25,9 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
 from intervalkin.paving.adjacency import shares_face
+from intervalkin.solve.window_fold import WHY_NOT
 
-__all__ = ["OpenPlace", "open_places", "PLACES_LISTED", "WHY_OPEN"]
+__all__ = ["OpenPlace", "open_places", "leaf_reasons", "why_counts", "PLACES_LISTED", "WHY_OPEN", "REASONS"]
 
 #: Why a leaf is open, as the ``places`` block of ``summary.json`` says it.
 WHY_OPEN = ("no model of any kind (volume_without_model, without_model): the Krawczyk test of "
@@ -36,6 +37,10 @@ WHY_OPEN = ("no model of any kind (volume_without_model, without_model): the Kra
             "are not proved connected: a cusp window, several pair windows, or a slope "
             "sign not certified); or a fold box with a piece of unknown count; "
             "window-clear leaves and window folds (volume_window_pieces) are not open")
+#: Why one open leaf is open, as each place's ``why`` counts them: no model of any kind; a window model whose
+#: pieces are not proved connected, for the reason :data:`~intervalkin.solve.window_fold.WHY_NOT` gives; a fold
+#: box one of whose pieces has no known count; anything else (none on the pavings measured).
+REASONS = ("no_model", *WHY_NOT, "fold_piece_count", "other")
 #: The largest places listed one by one (the totals cover all of them).
 PLACES_LISTED = 40
 
@@ -50,17 +55,41 @@ class OpenPlace:
     leaves: int
     without_model: int
     on_face: bool
+    why: tuple[tuple[str, int, float], ...] = ()
 
     def to_json(self) -> dict:
         return {"lo": list(self.lo), "hi": list(self.hi), "volume": self.volume, "leaves": self.leaves,
-                "without_model": self.without_model, "on_face": self.on_face}
+                "without_model": self.without_model, "on_face": self.on_face,
+                "why": {name: {"leaves": k, "volume": v} for name, k, v in self.why}}
+
+
+def why_counts(reason: np.ndarray, volume: np.ndarray) -> tuple[tuple[str, int, float], ...]:
+    """(name, leaves, volume) per :data:`REASONS` entry present among leaves with codes ``reason``."""
+    k = np.bincount(reason, minlength=len(REASONS))
+    v = np.bincount(reason, weights=volume, minlength=len(REASONS))
+    return tuple((REASONS[i], int(k[i]), float(v[i])) for i in np.flatnonzero(k).tolist())
+
+
+def leaf_reasons(open_leaf: np.ndarray, no_model: np.ndarray, window_why: np.ndarray | None,
+                 fold_box: np.ndarray) -> np.ndarray:
+    """(n,) int8 per leaf: why an open leaf is open, an index into :data:`REASONS` (-1 for the other leaves).
+    ``window_why``: the window models' reasons (:meth:`~intervalkin.space.joint_windows.JointWindows.why_not_pieced`,
+    -1 where none), ``fold_box``: the fold boxes of the local models."""
+    reason = np.full(open_leaf.shape, REASONS.index("other"), dtype=np.int8)
+    reason[no_model] = REASONS.index("no_model")
+    if window_why is not None:
+        reason[window_why >= 0] = 1 + window_why[window_why >= 0]
+    reason[fold_box] = REASONS.index("fold_piece_count")
+    return np.where(open_leaf, reason, -1).astype(np.int8)
 
 
 def open_places(level: np.ndarray, ijk: np.ndarray, lo: np.ndarray, hi: np.ndarray, open_leaf: np.ndarray,
-                no_model: np.ndarray, domain: np.ndarray) -> tuple[int, list[OpenPlace]]:
+                no_model: np.ndarray, domain: np.ndarray, reason: np.ndarray | None = None
+                ) -> tuple[int, list[OpenPlace]]:
     """(number of places, the largest :data:`PLACES_LISTED` of them by volume).
 
-    open_leaf (n,) bool: the open leaves; no_model (n,) bool: those without a local model.
+    open_leaf (n,) bool: the open leaves; no_model (n,) bool: those without a local model; reason (n,) int: why
+    each open leaf is open, an index into :data:`REASONS` (each place then counts its leaves and volume by reason).
     """
     idx = np.flatnonzero(open_leaf)
     if idx.size == 0:
@@ -76,8 +105,9 @@ def open_places(level: np.ndarray, ijk: np.ndarray, lo: np.ndarray, hi: np.ndarr
     touch = ((lo[idx] <= domain[:, 0]) | (hi[idx] >= domain[:, 1])).any(axis=1)
     for c in top:
         m = lab == c
+        why = () if reason is None else why_counts(np.asarray(reason)[idx][m], vol[m])
         out.append(OpenPlace(tuple(float(v) for v in lo[idx][m].min(axis=0)),
                              tuple(float(v) for v in hi[idx][m].max(axis=0)),
                              float(total[c]), int(m.sum()), int(np.count_nonzero(no_model[idx][m])),
-                             bool(touch[m].any())))
+                             bool(touch[m].any()), why))
     return int(n), out

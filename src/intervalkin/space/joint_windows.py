@@ -22,7 +22,7 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
-from intervalkin.solve.window_fold import CLEAR, FOLD, WindowFolds, window_folds
+from intervalkin.solve.window_fold import CLEAR, FOLD, WindowFolds, window_folds, why_not_pieced
 from intervalkin.solve.window_count import window_signature
 from intervalkin.solve.window_model import WindowModels, window_models
 from intervalkin.space.joint_leaves import leaves_to_paving, refine_leaves, timed_step
@@ -79,6 +79,14 @@ class JointWindows:
         """(n,) bool over the paving's leaves: the leaves with a window model."""
         out = np.zeros(n, dtype=bool)
         out[self.leaf[self.models.ok]] = True
+        return out
+
+    def why_not_pieced(self, n: int) -> np.ndarray:
+        """(n,) int8 over the paving's leaves: why a window-modelled leaf's pieces are not proved connected, an index
+        into :data:`~intervalkin.solve.window_fold.WHY_NOT`; -1 for the other leaves."""
+        out = np.full(n, -1, dtype=np.int8)
+        if self.folds is not None:
+            out[self.leaf] = why_not_pieced(self.models, self.folds)
         return out
 
     def signature_at(self, geometry: Geometry, leaf: np.ndarray, points: np.ndarray) -> np.ndarray:
