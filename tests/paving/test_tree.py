@@ -80,6 +80,14 @@ def test_leaves_tile_the_domain(paving5):
     assert np.all(occ == 1)
 
 
+def test_a_few_boxes_are_read_without_building_all(paving5):
+    """Paving.box(i) gives the rows of Paving.boxes, for one index and for an index array."""
+    every = paving5.boxes
+    idx = np.array([0, 5, len(paving5) - 1])
+    assert np.array_equal(paving5.box(7), every[7]) and paving5.box(7).shape == (3, 2)
+    assert np.array_equal(paving5.box(idx), every[idx])
+
+
 def test_float_bounds_match_integer_coordinates(paving5):
     p = paving5
     lo, hi = box_bounds(p.domain, p.level, p.ijk)

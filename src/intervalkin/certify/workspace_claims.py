@@ -53,7 +53,7 @@ def aspect_distinct_claims(geometry: Geometry, paving, precision: int = 128,
         order = np.concatenate([order[len(order) // 4:], order[: len(order) // 4]])
         want = 2 if sign > 0 else 1
         for i in order[:tries]:
-            box = paving.boxes[i]
+            box = paving.box(i)
             if box_label_proved(geometry, box, "W", 2, precision) and \
                     box_label_proved(geometry, box, "det_positive", want, precision):
                 chosen[aspect] = {"box": box_json(box), "aspect": aspect, "paving_index": int(i)}
@@ -84,7 +84,7 @@ def _region_claim(geometry, analysis, rho, cell, aspect, boxes, claim_id, precis
             "det_sign": sign,
             "piece": int(analysis.piece[i]),
             "region": int(analysis.region[i]),
-            "paving_box": {"index": i, "box": box_json(p.boxes[i]),
+            "paving_box": {"index": i, "box": box_json(p.box(i)),
                            "labels": labels_of(p, i, ("W", "det_positive", "off_Sc"))},
         })
     claim = {
@@ -146,7 +146,7 @@ def box_labels_claim(paving, sample: int, seed: int, precision: int = 128) -> di
         "seed": int(seed),
         "population": int(n),
         "sample_size": int(sample),
-        "boxes": [{"index": int(i), "box": box_json(paving.boxes[i]),
+        "boxes": [{"index": int(i), "box": box_json(paving.box(i)),
                    "labels": labels_of(paving, int(i), ("W", "det_positive"))} for i in idx],
         "statement": f"{len(idx)} boxes drawn from the {n} of the paving (seed {seed}) carry the stated W and "
                      "det A sign labels: INSIDE holds on the whole box, OUTSIDE fails on the whole box",

@@ -99,8 +99,12 @@ class Paving:
 
     @property
     def boxes(self) -> np.ndarray:
-        """Boxes as one array of shape (n, 3, 2)."""
+        """Boxes as one array of shape (n, 3, 2) (built on each access: use :meth:`box` for a few of them)."""
         return np.stack([self.lo, self.hi], axis=-1)
+
+    def box(self, index) -> np.ndarray:
+        """The boxes ``index`` (an int: shape (3, 2); an index array: (k, 3, 2)), without building all of them."""
+        return np.stack([self.lo[index], self.hi[index]], axis=-1)
 
     def volume(self) -> np.ndarray:
         """Volume of each box (n,), float (a measure, not a certified quantity)."""

@@ -207,7 +207,7 @@ def assign_sheets(geometry: Geometry, paving: Paving, piece: np.ndarray, piece_a
         todo.sort(key=lambda t: -piece_vol[t])
         if not todo:
             continue
-        boxes = paving.boxes[start_box[todo]]
+        boxes = paving.box(start_box[todo])
         got, _ = identify_sheets(geometry, joint, cid, q0, references, boxes, [piece_aspect[p] for p in todo])
         sheet[todo] = np.where(got >= 0, got, sheet[todo])
     return sheet, tuple(witnesses)
