@@ -90,3 +90,20 @@ def test_window_reasons_follow_the_windows(fold_paving):
         assert why[leaf] == expected, (leaf, kinds, why[leaf])
         seen.add(expected)
     assert {0, 1, 2, 3} <= seen  # every reason occurs on this paving
+
+
+def test_the_npz_gives_every_open_leaf_its_place_and_reason(fold_paving):
+    """Every place is listed in pavings/joint.npz, not only the largest in summary.json: open_place and open_reason
+    are set exactly on the open leaves, and place k of the columns is the k-th place of the summary's list."""
+    cols = fold_paving.columns()
+    place, reason = cols["open_place"], cols["open_reason"]
+    assert np.array_equal(place >= 0, reason >= 0)
+    places = fold_paving.open_places()["places"]
+    assert place.max() + 1 == places["count"]
+    for q in places["largest"][:5]:
+        mine = place == q["place"]
+        assert mine.sum() == q["leaves"]
+        assert cols["lo"][mine].min(axis=0).tolist() == q["lo"] and cols["hi"][mine].max(axis=0).tolist() == q["hi"]
+        counts = np.bincount(reason[mine], minlength=len(REASONS))
+        assert {REASONS[i]: int(counts[i]) for i in np.flatnonzero(counts)} == {k: v["leaves"]
+                                                                              for k, v in q["why"].items()}

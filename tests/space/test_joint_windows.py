@@ -60,7 +60,8 @@ def test_window_leaves_without_pieces_stay_open_for_the_counts(fold_paving):
                       + v[fold_paving.counted_fold_mask()].sum(), v.sum())
     assert "window model" in places["why"]
     assert set(fold_paving.columns()) == {"lo", "hi", "level", "cell", "count", "n_wa1", "n_wa2", "fold_axis",
-                                          "cell_below", "cell_above", "count_below", "count_above"}
+                                          "cell_below", "cell_above", "count_below", "count_above",
+                                          "open_reason", "open_place"}
 
 
 def test_window_pieces_carry_their_cells_signature(fold_paving, paper_geometry):

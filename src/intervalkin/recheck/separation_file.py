@@ -9,7 +9,7 @@ face rectangles).  :func:`check_separation` proves, from the files and the geome
    the claim's signature (the arb checker, :func:`intervalkin.checker.claims.run_check`);
 2. no point of any barrier box has exactly c solutions, c the signature's count
    (:func:`~intervalkin.recheck.count_range.count_ranges`);
-3. the boundary of S inside the open joint box is covered by the barrier: on every plane
+3. the boundary of S inside the open joint box is covered by the barrier (:mod:`~intervalkin.recheck.region_boundary`): on every plane
    x_a = v that holds a face of a box of S, with v strictly between the joint limits of axis a,
    the plane is cut into open cells by every rectangle edge met there; a cell that S reaches from
    one side only must lie in some barrier box (:func:`uncovered_boundary`);
@@ -46,6 +46,7 @@ from intervalkin.recheck.arc_pattern import (MAX_COUNT, box_arcs, face_relations
 from intervalkin.recheck.count_range import count_ranges, supported
 from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.recheck.paving_file import folder_geometry
+from intervalkin.recheck.region_boundary import face_pairs, require_covered, uncovered_boundary
 
 __all__ = ["CLAIMS", "ARRAYS", "KIND", "uncovered_boundary", "face_pairs", "check_separation",
            "check_pattern_separation", "recheck_separations", "barrier_bound"]
@@ -60,63 +61,6 @@ MIN_PART = 400
 _COLUMNS = ("region_lo", "region_hi", "region_claim", "barrier_lo", "barrier_hi", "barrier_claim")
 #: Columns only pattern barriers need (a file of count barriers alone may lack them).
 _PATTERN_COLUMNS = ("barrier_box", "barrier_outer_lo", "barrier_outer_hi", "pattern_box", "pattern_rows")
-#: Region boxes compared at once when looking for the pairs that share a face.
-_CHUNK = 2048
-
-
-def _cover(u: np.ndarray, w: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """(len(u) - 1, len(w) - 1) bool: the open grid cells (u_i, u_i+1) x (w_j, w_j+1) inside some closed
-    rectangle [lo, hi] (rows: u then w); u and w sorted, holding every rectangle end."""
-    grid = np.zeros((u.size, w.size), dtype=np.int64)
-    i0, i1 = np.searchsorted(u, lo[:, 0]), np.searchsorted(u, hi[:, 0])
-    j0, j1 = np.searchsorted(w, lo[:, 1]), np.searchsorted(w, hi[:, 1])
-    np.add.at(grid, (i0, j0), 1)
-    np.add.at(grid, (i1, j0), -1)
-    np.add.at(grid, (i0, j1), -1)
-    np.add.at(grid, (i1, j1), 1)
-    return grid.cumsum(axis=0).cumsum(axis=1)[:-1, :-1] > 0
-
-
-def uncovered_boundary(region_lo: np.ndarray, region_hi: np.ndarray, barrier_lo: np.ndarray,
-                       barrier_hi: np.ndarray, geometry: Geometry) -> tuple[int, tuple | None]:
-    """(number of open plane cells on the boundary of the region, inside the open joint box, that no barrier
-    box covers; (axis, plane, cell centre) of the first one, or None)."""
-    missing, first = 0, None
-    for ax in range(3):
-        rest = [k for k in range(3) if k != ax]
-        lim_lo, lim_hi = Fraction(geometry.rho_min[ax]), Fraction(geometry.rho_max[ax])
-        planes = np.unique(np.concatenate([region_lo[:, ax], region_hi[:, ax]]))
-        for v in planes:
-            if not lim_lo < Fraction(float(v)) < lim_hi:
-                continue  # a path in the open joint box never reaches this plane
-            below = (region_lo[:, ax] < v) & (v <= region_hi[:, ax])
-            above = (region_lo[:, ax] <= v) & (v < region_hi[:, ax])
-            wall = (barrier_lo[:, ax] <= v) & (v <= barrier_hi[:, ax])
-            lo = np.concatenate([region_lo[below | above][:, rest], barrier_lo[wall][:, rest]])
-            hi = np.concatenate([region_hi[below | above][:, rest], barrier_hi[wall][:, rest]])
-            u, w = np.unique(np.r_[lo[:, 0], hi[:, 0]]), np.unique(np.r_[lo[:, 1], hi[:, 1]])
-            if u.size < 2 or w.size < 2:
-                continue
-            side_b = _cover(u, w, region_lo[below][:, rest], region_hi[below][:, rest])
-            side_a = _cover(u, w, region_lo[above][:, rest], region_hi[above][:, rest])
-            walled = _cover(u, w, barrier_lo[wall][:, rest], barrier_hi[wall][:, rest])
-            bad = (side_b ^ side_a) & ~walled
-            if bad.any():
-                missing += int(bad.sum())
-                if first is None:
-                    i, j = np.argwhere(bad)[0]
-                    first = (ax, float(v), (float((u[i] + u[i + 1]) / 2), float((w[j] + w[j + 1]) / 2)))
-    return missing, first
-
-
-def _require_covered(r_lo: np.ndarray, r_hi: np.ndarray, b_lo: np.ndarray, b_hi: np.ndarray,
-                     geometry: Geometry) -> None:
-    """Refuse unless the region's boundary inside the open joint box lies on the barrier boxes."""
-    missing, first = uncovered_boundary(r_lo, r_hi, b_lo, b_hi, geometry)
-    if missing:
-        ax, v, centre = first
-        raise Refused(f"{missing} cells of the region's boundary lie on no barrier box, the first on rho_{ax + 1} = "
-                      f"{v} around {centre}")
 
 
 def _witness(geometry: Geometry, obj, what: str) -> tuple[tuple[Fraction, ...], tuple[int, int, int]]:
@@ -160,7 +104,7 @@ def check_separation(geometry: Geometry, claim: dict, region: tuple[np.ndarray, 
         i = int(np.flatnonzero(~free)[0])
         raise Refused(f"{int((~free).sum())} barrier boxes not proved free of {sig[0]} solutions, the first "
                       f"[{b_lo[i].tolist()}, {b_hi[i].tolist()}]")
-    _require_covered(r_lo, r_hi, b_lo, b_hi, geometry)
+    require_covered(r_lo, r_hi, b_lo, b_hi, geometry)
     facts = {"signature": sig, "cell": claim.get("cell"), "others": cells}
     return (f"cell {claim.get('cell')} and cells {', '.join(map(str, cells))} ({sig[0]} solutions) lie in different "
             f"components of the joint box minus g(S): {len(r_lo)} region boxes, their boundary covered by "
@@ -196,23 +140,6 @@ def _common(geometry: Geometry, claim: dict, boxes: dict[str, tuple[np.ndarray, 
             raise Refused(f"others[{k}]: its solutions give {got}, not the claimed signature {sig}")
         rest.append((y, other))
     return sig, x, claim["witness"], rest
-
-
-def face_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Every pair i < j of closed boxes whose intersection has dimension 2 or 3 (a shared piece of face, or an
-    overlap): exact float comparisons, in chunks of rows."""
-    n = lo.shape[0]
-    out_i, out_j = [], []
-    for s in range(0, n, _CHUNK):
-        blo, bhi = lo[s:s + _CHUNK, None, :], hi[s:s + _CHUNK, None, :]
-        ext_lo, ext_hi = np.maximum(blo, lo[None]), np.minimum(bhi, hi[None])
-        meet = np.all(ext_lo <= ext_hi, axis=2) & ((ext_lo < ext_hi).sum(axis=2) >= 2)
-        i, j = np.nonzero(meet)
-        i = i + s
-        keep = i < j
-        out_i.append(i[keep])
-        out_j.append(j[keep])
-    return np.concatenate(out_i), np.concatenate(out_j)
 
 
 def _solution_phi(witness: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -299,7 +226,7 @@ def check_pattern_separation(geometry: Geometry, claim: dict, region: tuple[np.n
             t = int(at[open_[0]])
             raise Refused(f"barrier box {t} [{b_lo[t].tolist()}, {b_hi[t].tolist()}]: a pattern of its region "
                           "box's set is not excluded there")
-    _require_covered(r_lo, r_hi, b_lo, b_hi, geometry)
+    require_covered(r_lo, r_hi, b_lo, b_hi, geometry)
     facts = {"signature": sig, "cell": claim.get("cell"), "others": cells}
     return (f"cell {claim.get('cell')} and cells {', '.join(map(str, cells))} ({count} solutions) lie in different "
             f"components of the joint box minus g(S): {len(r_lo)} region boxes with the patterns of the cell's "

@@ -63,7 +63,7 @@ from intervalkin.space.joint_leaves import adaptive_leaves, leaves_to_paving, re
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
 from intervalkin.space.joint_models import ModelStore
 from intervalkin.space.joint_pieces import FoldPieces, PieceSignatures, piece_signatures
-from intervalkin.space.joint_places import WHY_OPEN, leaf_reasons, open_places, why_counts
+from intervalkin.space.joint_places import WHY_OPEN, open_leaves, open_places, place_labels, why_counts
 from intervalkin.space.joint_window_pieces import (check_window_cells, signatures_from_windows, window_cell_of,
                                                    window_columns, window_pieces)
 from intervalkin.space.joint_windows import JointWindows, window_refinement
@@ -130,16 +130,8 @@ class JointSpacePaving:
         leaves, the certified share, the fragments, the fold pieces joined to no cell, and the places
         (face-connected groups of open leaves, :mod:`intervalkin.space.joint_places`), the largest listed."""
         fs = self.fold_stats
-        open_leaf = (self.cell < 0) & ~self.counted_fold_mask() & ~self.pieced_mask()
-        fold = np.zeros(len(self.cell), dtype=bool)
-        if self.pieces is not None and len(self.pieces):
-            fold[self.pieces.box] = True
+        open_leaf, no_model, windowed, reason = open_leaves(self)
         p = self.paving
-        windowed = self.windows.modelled_mask(len(self.cell)) if self.windows is not None else np.zeros_like(fold)
-        no_model = (self.cell < 0) & ~fold & ~windowed
-        windowed &= ~self.pieced_mask()  # open for the counts all the same: a point model proves no pieces
-        why = self.windows.why_not_pieced(len(self.cell)) if self.windows is not None else None
-        reason = leaf_reasons(open_leaf, no_model, why, fold)
         n, largest = open_places(p.level, p.ijk, p.lo, p.hi, open_leaf, no_model, p.domain, reason)
         return {"joint_volume": self.undecided_volume(), "joint_certified_share": self.certified_share(),
                 "fragments": [{"count": c.count, "volume": c.volume, "witness": [str(v) for v in c.witness]}
@@ -238,7 +230,9 @@ class JointSpacePaving:
         boxes: fold_axis (the axis k of the sheet, -1 elsewhere), cell_below and cell_above (the cells of
         the pieces q_k < h and q_k > h, -1 elsewhere or unknown), count_below and count_above (their
         certified counts, inferred where the piece has no cell; -1 where unknown); window-clear leaves
-        and window folds likewise (:func:`intervalkin.space.joint_window_pieces.window_columns`)."""
+        and window folds likewise (:func:`intervalkin.space.joint_window_pieces.window_columns`); for the open
+        leaves, open_reason (an index into :data:`~intervalkin.space.joint_places.REASONS`) and open_place (the
+        place's id, by decreasing volume, as ``summary.json`` lists places); -1 for the other leaves."""
         count = np.full(len(self.cell), -1, dtype=np.int32)
         wa1, wa2 = count.copy(), count.copy()
         for c in self.cells + self.fragments:
@@ -253,10 +247,13 @@ class JointSpacePaving:
             if self.piece_signatures is not None:
                 n_below[self.pieces.box] = self.piece_signatures.signature[:, 0, 0]
                 n_above[self.pieces.box] = self.piece_signatures.signature[:, 1, 0]
-        cols = {"lo": self.paving.lo, "hi": self.paving.hi, "level": self.paving.level.astype(np.int32),
+        open_leaf, _, _, reason = open_leaves(self)
+        p = self.paving
+        cols = {"lo": p.lo, "hi": p.hi, "level": p.level.astype(np.int32),
                 "cell": self.cell.astype(np.int32), "count": count, "n_wa1": wa1, "n_wa2": wa2,
                 "fold_axis": axis, "cell_below": below, "cell_above": above,
-                "count_below": n_below, "count_above": n_above}
+                "count_below": n_below, "count_above": n_above, "open_reason": reason,
+                "open_place": place_labels(p.level, p.ijk, p.lo, p.hi, open_leaf)[1]}
         return cols if self.windows is None else window_columns(cols, self.windows, self.window_cell)
 
 

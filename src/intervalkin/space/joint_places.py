@@ -27,7 +27,7 @@ from scipy.sparse.csgraph import connected_components
 from intervalkin.paving.adjacency import shares_face
 from intervalkin.solve.window_fold import WHY_NOT
 
-__all__ = ["OpenPlace", "open_places", "leaf_reasons", "why_counts", "PLACES_LISTED", "WHY_OPEN", "REASONS"]
+__all__ = ["OpenPlace", "open_leaves", "open_places", "place_labels", "leaf_reasons", "why_counts", "PLACES_LISTED", "WHY_OPEN", "REASONS"]
 
 #: Why a leaf is open, as the ``places`` block of ``summary.json`` says it.
 WHY_OPEN = ("no model of any kind (volume_without_model, without_model): the Krawczyk test of "
@@ -47,7 +47,9 @@ PLACES_LISTED = 40
 
 @dataclass(frozen=True)
 class OpenPlace:
-    """A face-connected group of open leaves: bounding box (3, 2) lists, volume, leaves, how many lack a model."""
+    """A face-connected group of open leaves: bounding box (3, 2) lists, volume, leaves, how many lack a model,
+    whether it touches a face of the joint box, its leaves and volume by reason, and its id (the ``open_place``
+    column of ``pavings/joint.npz``)."""
 
     lo: tuple[float, float, float]
     hi: tuple[float, float, float]
@@ -56,10 +58,11 @@ class OpenPlace:
     without_model: int
     on_face: bool
     why: tuple[tuple[str, int, float], ...] = ()
+    place: int = -1
 
     def to_json(self) -> dict:
-        return {"lo": list(self.lo), "hi": list(self.hi), "volume": self.volume, "leaves": self.leaves,
-                "without_model": self.without_model, "on_face": self.on_face,
+        return {"place": self.place, "lo": list(self.lo), "hi": list(self.hi), "volume": self.volume,
+                "leaves": self.leaves, "without_model": self.without_model, "on_face": self.on_face,
                 "why": {name: {"leaves": k, "volume": v} for name, k, v in self.why}}
 
 
@@ -83,6 +86,41 @@ def leaf_reasons(open_leaf: np.ndarray, no_model: np.ndarray, window_why: np.nda
     return np.where(open_leaf, reason, -1).astype(np.int8)
 
 
+def open_leaves(jp) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """For a :class:`~intervalkin.space.joint_paving.JointSpacePaving`: (n,) masks of its open leaves, of those
+    without a model of any kind and of the open window-modelled ones; and why each open leaf is open
+    (:func:`leaf_reasons`)."""
+    n = len(jp.cell)
+    open_leaf = (jp.cell < 0) & ~jp.counted_fold_mask() & ~jp.pieced_mask()
+    fold = np.zeros(n, dtype=bool)
+    if jp.pieces is not None and len(jp.pieces):
+        fold[jp.pieces.box] = True
+    windowed = jp.windows.modelled_mask(n) if jp.windows is not None else np.zeros(n, dtype=bool)
+    no_model = (jp.cell < 0) & ~fold & ~windowed
+    why = jp.windows.why_not_pieced(n) if jp.windows is not None else None
+    # a window-modelled leaf is open for the counts all the same: a point model proves no pieces
+    return open_leaf, no_model, windowed & ~jp.pieced_mask(), leaf_reasons(open_leaf, no_model, why, fold)
+
+
+def place_labels(level: np.ndarray, ijk: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                 open_leaf: np.ndarray) -> tuple[int, np.ndarray]:
+    """(number of places, (n,) int32 place of each open leaf, -1 for the others).  Place 0 has the largest
+    volume, then 1, and so on (ties by first leaf); the ``largest`` list of :func:`open_places` follows that order."""
+    out = np.full(len(open_leaf), -1, dtype=np.int32)
+    idx = np.flatnonzero(open_leaf)
+    if idx.size == 0:
+        return 0, out
+    depth = int(np.asarray(level)[idx].max())
+    e = shares_face(level[idx], ijk[idx], depth, periodic=(False, False, False))
+    g = csr_matrix((np.ones(e.shape[1]), (e[0], e[1])), shape=(idx.size, idx.size))
+    n, lab = connected_components(g, directed=False)
+    total = np.bincount(lab, weights=np.prod(hi[idx] - lo[idx], axis=1), minlength=n)
+    rank = np.empty(n, dtype=np.int32)
+    rank[np.argsort(-total, kind="stable")] = np.arange(n, dtype=np.int32)
+    out[idx] = rank[lab]
+    return int(n), out
+
+
 def open_places(level: np.ndarray, ijk: np.ndarray, lo: np.ndarray, hi: np.ndarray, open_leaf: np.ndarray,
                 no_model: np.ndarray, domain: np.ndarray, reason: np.ndarray | None = None
                 ) -> tuple[int, list[OpenPlace]]:
@@ -94,13 +132,11 @@ def open_places(level: np.ndarray, ijk: np.ndarray, lo: np.ndarray, hi: np.ndarr
     idx = np.flatnonzero(open_leaf)
     if idx.size == 0:
         return 0, []
-    depth = int(np.asarray(level)[idx].max())
-    e = shares_face(level[idx], ijk[idx], depth, periodic=(False, False, False))
-    g = csr_matrix((np.ones(e.shape[1]), (e[0], e[1])), shape=(idx.size, idx.size))
-    n, lab = connected_components(g, directed=False)
+    n, place = place_labels(level, ijk, lo, hi, open_leaf)
+    lab = place[idx]
     vol = np.prod(hi[idx] - lo[idx], axis=1)
     total = np.bincount(lab, weights=vol, minlength=n)
-    top = np.argsort(-total, kind="stable")[:PLACES_LISTED]
+    top = np.arange(min(n, PLACES_LISTED))  # place ids run by decreasing volume
     out = []
     touch = ((lo[idx] <= domain[:, 0]) | (hi[idx] >= domain[:, 1])).any(axis=1)
     for c in top:
@@ -109,5 +145,5 @@ def open_places(level: np.ndarray, ijk: np.ndarray, lo: np.ndarray, hi: np.ndarr
         out.append(OpenPlace(tuple(float(v) for v in lo[idx][m].min(axis=0)),
                              tuple(float(v) for v in hi[idx][m].max(axis=0)),
                              float(total[c]), int(m.sum()), int(np.count_nonzero(no_model[idx][m])),
-                             bool(touch[m].any()), why))
+                             bool(touch[m].any()), why, int(c)))
     return int(n), out
