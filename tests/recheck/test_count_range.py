@@ -15,7 +15,8 @@ import pytest
 
 import intervalkin.recheck.count_range as cr_mod
 from intervalkin.core.geometry import load_geometry
-from intervalkin.recheck.count_range import NO_BOUND, count_ranges, r_box, supported
+from intervalkin.recheck.count_range import NO_BOUND, count_lower, count_ranges, excludes_count, r_box, supported
+from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.solve.dkp import solve
 from tests.conftest import SECOND_DESIGN
 
@@ -54,6 +55,31 @@ def test_ranges_hold_the_certified_counts(geometry):
     assert len(seen) > 100
     for i, c in seen:
         assert ranges.lo[i] <= c <= ranges.hi[i], (lo[i], hi[i], c, ranges.lo[i], ranges.hi[i])
+
+
+def test_cut_sign_changes_bound_the_count_below(geometry):
+    """Statement 2 with the cut angles as the only points (count_lower, the barriers' first test): never above the
+    solver's count at a point of the box, and not vacuous."""
+    lo, hi, rng = _boxes(geometry, 13, 40)
+    low = count_lower(reduced_constants(geometry), lo, hi)
+    seen = _counts_at(geometry, lo, hi, rng, 2)
+    assert len(seen) > 60
+    for i, c in seen:
+        assert low[i] <= c, (lo[i], hi[i], c, low[i])
+    assert sum(low[i] > 0 for i, _ in seen) > len(seen) // 3
+
+
+def test_excludes_count_holds_the_solver_counts(geometry):
+    """Where excludes_count proves a box free of a count the solver never finds it there, and it proves at least
+    what the ranges alone prove (the cut signs only come first)."""
+    lo, hi, rng = _boxes(geometry, 17, 40)
+    seen = _counts_at(geometry, lo, hi, rng, 2)
+    ranges = count_ranges(geometry, lo, hi)
+    for c in (0, 2, 4):
+        free = excludes_count(geometry, lo, hi, c)
+        assert np.all(free | ~ranges.excludes(c))
+        assert not any(free[i] and n == c for i, n in seen)
+    assert excludes_count(geometry, lo[:0], hi[:0], 2).shape == (0,)
 
 
 def test_ranges_decide_small_boxes(paper_geometry):

@@ -5,7 +5,7 @@ A *count barrier* for a cell C with c solutions is a finite set S of closed join
 
 * the boundary of S inside the open joint box lies in the union of the barrier rectangles;
 * no point of any barrier rectangle has exactly c solutions (proved by
-  :func:`intervalkin.recheck.count_range.count_ranges`);
+  :func:`intervalkin.recheck.count_range.excludes_count`);
 * a witness of C lies in the interior of a box of S, and a witness of every other cell of
   C's signature lies outside S.
 
@@ -42,7 +42,7 @@ from intervalkin.core.workers import Beside, Workers, default_workers
 from intervalkin.paving.adjacency import shares_face
 from intervalkin.paving.tree import box_bounds
 from intervalkin.recheck.arc_pattern import MAX_COUNT, box_arcs, pack
-from intervalkin.recheck.count_range import count_ranges, supported
+from intervalkin.recheck.count_range import excludes_count, supported
 from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.space.joint_closure import piece_cells
 from intervalkin.space.joint_separation import ANY, possible_counts
@@ -161,7 +161,7 @@ def _grow(geometry: Geometry, p, a: np.ndarray, b: np.ndarray, region: np.ndarra
             pick = todo[np.linspace(0, todo.size - 1, SAMPLE).astype(np.int64)]
             lo = np.maximum(p.lo[a[pick]], p.lo[b[pick]])
             hi = np.minimum(p.hi[a[pick]], p.hi[b[pick]])
-            ok = count_ranges(geometry, lo, hi, workers=workers).excludes(count)
+            ok = excludes_count(geometry, lo, hi, count, workers)
             proved.update(zip(pick.tolist(), ok.tolist()))
             if (~ok).mean() > MAX_FAIL_SHARE:
                 return None, (f"{(~ok).mean():.0%} of a sample of its boundary faces hold points of {count} solutions "
@@ -170,7 +170,7 @@ def _grow(geometry: Geometry, p, a: np.ndarray, b: np.ndarray, region: np.ndarra
         if todo.size:
             lo = np.maximum(p.lo[a[todo]], p.lo[b[todo]])
             hi = np.minimum(p.hi[a[todo]], p.hi[b[todo]])
-            proved.update(zip(todo.tolist(), count_ranges(geometry, lo, hi, workers=workers).excludes(count).tolist()))
+            proved.update(zip(todo.tolist(), excludes_count(geometry, lo, hi, count, workers).tolist()))
         fail = np.array([e for e in edge.tolist() if not proved[e]], dtype=np.int64)
         if fail.size == 0:
             return (np.flatnonzero(region), edge), "", len(proved)

@@ -28,15 +28,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from intervalkin.recheck.arith import PI_HI, PI_LO
-from intervalkin.recheck.count_range import NO_BOUND, PIECES, arc_ranges, r_box
-from intervalkin.recheck.reduced_equation import ReducedConstants, d_sign, derivative_enclosures, sign_at_points
+from intervalkin.recheck.count_range import GRID, NO_BOUND, PIECES, arc_ranges, cut_angles, cut_signs, r_box
+from intervalkin.recheck.reduced_equation import ReducedConstants, d_sign, derivative_enclosures
 
 __all__ = ["GRID", "WHOLE", "MAX_COUNT", "cut_angles", "cut_signs", "arc_starts", "ArcTable", "arc_table",
            "BoxArcs", "box_arcs", "own_patterns", "face_relations", "count_bounds", "split_excludes", "prune_relations",
            "pattern_of_angles", "pack", "unpack"]
 
-#: Fixed candidate cut angles on the circle.
-GRID = 64
 #: The start index of the one arc of a box without cuts (the whole circle).
 WHOLE = -1
 #: Solutions at most (the sextic): the width of a pattern row.
@@ -54,21 +52,6 @@ FACE_DEPTH = 9
 #: (:func:`split_excludes`), tried in this order.  The whole face (1) proved none that 2 x 2 did not, in the
 #: floods of the paper's depth-5 paving and of the second design.
 SPLITS = (2, 4)
-
-
-def cut_angles(grid: int = GRID) -> np.ndarray:
-    """The candidate cut angles -pi + (j + 1/2) 2 pi / grid (binary64 values, taken as exact), inside (-pi, pi)."""
-    return -np.pi + (np.arange(grid) + 0.5) * (2 * np.pi / grid)
-
-
-def cut_signs(k: ReducedConstants, q_lo: np.ndarray, q_hi: np.ndarray, grid: int = GRID) -> np.ndarray:
-    """(n, grid) int8: the proved sign of f at each candidate cut over each joint box (0: not proved)."""
-    q_lo, q_hi = np.atleast_2d(q_lo), np.atleast_2d(q_hi)
-    r_lo, r_hi = r_box(q_lo, q_hi)
-    n = q_lo.shape[0]
-    ang = np.tile(cut_angles(grid), n)
-    s = sign_at_points(k, np.repeat(r_lo, grid, axis=0), np.repeat(r_hi, grid, axis=0), ang, ang)
-    return s.reshape(n, grid)
 
 
 def arc_starts(mask: np.ndarray) -> np.ndarray:

@@ -8,7 +8,7 @@ face rectangles).  :func:`check_separation` proves, from the files and the geome
 1. every witness's solution list is complete, with the declared count and split, and all declare
    the claim's signature (the arb checker, :func:`intervalkin.checker.claims.run_check`);
 2. no point of any barrier box has exactly c solutions, c the signature's count
-   (:func:`~intervalkin.recheck.count_range.count_ranges`);
+   (:func:`~intervalkin.recheck.count_range.excludes_count`);
 3. the boundary of S inside the open joint box is covered by the barrier (:mod:`~intervalkin.recheck.region_boundary`): on every plane
    x_a = v that holds a face of a box of S, with v strictly between the joint limits of axis a,
    the plane is cut into open cells by every rectangle edge met there; a cell that S reaches from
@@ -43,7 +43,7 @@ from intervalkin.core.workers import Workers, default_workers
 from intervalkin.recheck.arith import fraction_enclosure
 from intervalkin.recheck.arc_pattern import (MAX_COUNT, box_arcs, face_relations, own_patterns,
                                              pattern_of_angles, prune_relations, unpack)
-from intervalkin.recheck.count_range import count_ranges, supported
+from intervalkin.recheck.count_range import excludes_count, supported
 from intervalkin.recheck.reduced_equation import reduced_constants
 from intervalkin.recheck.paving_file import folder_geometry
 from intervalkin.recheck.region_boundary import face_pairs, require_covered, uncovered_boundary
@@ -98,8 +98,7 @@ def check_separation(geometry: Geometry, claim: dict, region: tuple[np.ndarray, 
         if np.any(np.all((r_lo <= y_hi) & (y_lo <= r_hi), axis=1)):
             raise Refused(f"others[{k}]: its witness may lie in the region")
         cells.append(other.get("cell"))
-    free = (count_ranges(geometry, b_lo, b_hi, workers=workers).excludes(sig[0]) if b_lo.size
-            else np.zeros(0, dtype=bool))
+    free = excludes_count(geometry, b_lo, b_hi, sig[0], workers)
     if not free.all():
         i = int(np.flatnonzero(~free)[0])
         raise Refused(f"{int((~free).sum())} barrier boxes not proved free of {sig[0]} solutions, the first "
