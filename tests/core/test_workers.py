@@ -60,6 +60,36 @@ def test_beside_computes_in_a_second_process_and_passes_errors_on(monkeypatch):
         assert side.result()[1] == os.getpid()
 
 
+def _sleep(seconds: float) -> None:
+    import time
+    time.sleep(seconds)
+
+
+def test_a_second_process_stopped_at_once_ends_and_never_runs_this_one(monkeypatch):
+    """The command line turns SIGTERM into SystemExit.  A second process stopped right after its fork, before it
+    runs its own code, must end there: not raise that exit in its copy of this process's stack and go on with
+    this process's work (here: this loop, which would then run twice), and not hold the caller in a join."""
+    import signal
+    import time
+
+    def exit_on_term(signum, frame):
+        raise SystemExit(128 + signum)
+
+    previous = signal.signal(signal.SIGTERM, exit_on_term)
+    me = os.getpid()
+    try:
+        t0 = time.perf_counter()
+        for _ in range(30):
+            with Beside(_sleep, 60.0) as side:
+                pid = side._proc.pid
+            assert os.getpid() == me  # a child that escaped into this loop would fail here, in its own copy
+            with pytest.raises(ProcessLookupError):
+                os.kill(pid, 0)  # ended and reaped
+        assert time.perf_counter() - t0 < 60
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def test_bad_worker_counts_are_refused():
     for bad in (0, -1, True, 1.5):
         with pytest.raises(ValueError):

@@ -15,8 +15,10 @@ worker, or for small calls, everything runs here, in order.
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
+import signal
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any, Callable, Sequence
 
@@ -155,7 +157,8 @@ class Beside:
             ctx = multiprocessing.get_context("fork")
             self._recv, send = ctx.Pipe(duplex=False)
             self._proc = ctx.Process(target=_send_result, args=(send, fn, args), daemon=True)
-            self._proc.start()
+            with _sigterm_blocked():  # the child unblocks it once it runs its own code (_send_result)
+                self._proc.start()
             send.close()
 
     def __enter__(self) -> "Beside":
@@ -165,6 +168,9 @@ class Beside:
         if self._proc is not None:
             if self._proc.is_alive():
                 self._proc.terminate()
+                self._proc.join(EXIT_WAIT)
+                if self._proc.is_alive():  # a child that ignored SIGTERM must not hold this process forever
+                    self._proc.kill()
             self._proc.join()
             self._recv.close()
             self._proc = None
@@ -185,7 +191,31 @@ class Beside:
         return value
 
 
+#: Seconds a stopped second process is given to end before it is killed.
+EXIT_WAIT = 5.0
+
+
+@contextlib.contextmanager
+def _sigterm_blocked():
+    """SIGTERM held pending in this thread meanwhile.  A child forked here inherits the blocked signal: a SIGTERM
+    sent right after the fork, before the child runs :func:`_send_result`, would otherwise run this process's
+    handler (the command line's raises SystemExit) in the copy of this process's stack, and the child would go
+    on with the parent's work (a test runner's loop, the parent's clean-up of its temporary files)."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 def _send_result(send, fn: Callable[..., Any], args: tuple) -> None:
+    if hasattr(signal, "pthread_sigmask"):
+        # this process's own code from here: SIGTERM ends it (a pending one now), whatever handler the parent had
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
     try:
         out = (True, _limited(fn, args))
     except BaseException as exc:  # sent back whole, to be raised by the caller
