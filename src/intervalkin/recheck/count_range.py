@@ -260,7 +260,7 @@ def excludes_count(geometry: Geometry, q_lo: np.ndarray, q_hi: np.ndarray, count
                    workers: Workers | None = None) -> np.ndarray:
     """(n,) bool: PROVED that no point of box i has ``count`` solutions: :func:`count_lower` above ``count``, else
     the range of :func:`count_ranges` (on ``workers``) excludes it.  Next to a cell with more solutions the cut
-    signs alone decide most boxes (91 % of the walls of the paper's barriers around its cells without solutions)."""
+    signs alone decide most boxes (90 % of the walls of the paper's barriers around its cells without solutions)."""
     q_lo, q_hi = np.atleast_2d(q_lo), np.atleast_2d(q_hi)
     if q_lo.shape[0] == 0:
         return np.zeros(0, dtype=bool)
