@@ -113,11 +113,9 @@ def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITI
     n = len(models.ok)
     w = len(models.degree)
     ends = models.end_signs.astype(np.int64)
-    # a window with an end sign or a sign of D not proved for the whole box is decided only at points
-    firm = (ends != 0).all(axis=1) & (models.d_sign != 0)
-    even = firm & (ends[:, 0] == ends[:, 1])
+    firm, even, cusp = _window_kinds(models)
     constant = firm & (models.degree == 2) & ~even
-    cusp = ~firm | ((models.degree == 3) & ~even)
+    cusp = ~firm | cusp  # decided only at points: treated like a cusp window
     box = models.window_box
     n_pair = np.bincount(box, weights=even, minlength=n)
     n_cusp = np.bincount(box, weights=cusp, minlength=n)
@@ -160,17 +158,24 @@ def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITI
     return WindowFolds(kind, window, rising, signature, edge_rising)
 
 
+def _window_kinds(models: WindowModels) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(firm, pair, cusp) per window: end signs and sign of D proved over the whole box (a window that is not firm
+    is decided only at points); a firm window with equal end signs (0 or 2 roots); a firm window of degree 3
+    with end signs that differ (1 or 3 roots)."""
+    ends = models.end_signs.astype(np.int64)
+    firm = (ends != 0).all(axis=1) & (models.d_sign != 0)
+    even = firm & (ends[:, 0] == ends[:, 1])
+    return firm, even, firm & (models.degree == 3) & ~even
+
+
 def why_not_pieced(models: WindowModels, folds: WindowFolds) -> np.ndarray:
     """(n,) int8 per box of ``models``: the index in :data:`WHY_NOT` of the first reason its pieces are not proved
     connected, -1 for window-clear boxes, window folds and boxes without a model.  The classes follow the windows'
     kinds as :func:`window_folds` reads them (a label for reports, not a claim)."""
     n = len(models.ok)
-    ends = models.end_signs.astype(np.int64)
-    firm = (ends != 0).all(axis=1) & (models.d_sign != 0)
-    even = firm & (ends[:, 0] == ends[:, 1])
+    firm, even, cusp = _window_kinds(models)
     box = models.window_box
-    count = [np.bincount(box, weights=w, minlength=n) > t for w, t in (
-        (firm & (models.degree == 3) & ~even, 0), (~firm, 0), (even, 1), (even, 0))]
+    count = [np.bincount(box, weights=w, minlength=n) > t for w, t in ((cusp, 0), (~firm, 0), (even, 1), (even, 0))]
     out = np.full(n, -1, dtype=np.int8)
     for code in range(len(WHY_NOT) - 1, -1, -1):  # the first reason wins
         out[count[code]] = code
