@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ['shares_face', 'shares_face_bruteforce', 'touching_pairs', 'touching_pairs_bruteforce', 'adjacency_graph', 'component_labels', 'connected_components']
+__all__ = ['shares_face', 'shares_face_bruteforce', 'directed_face_pairs', 'touching_pairs', 'touching_pairs_bruteforce', 'adjacency_graph', 'component_labels', 'connected_components']
 
 
 # --------------------------------------------------------------------------------------
@@ -297,3 +297,36 @@ def connected_components(n: int, edges: np.ndarray, mask: np.ndarray) -> list[fr
 
     g = adjacency_graph(n, edges, np.flatnonzero(mask))
     return [frozenset(c) for c in nx.connected_components(g)]
+
+
+def directed_face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int, periodic=(False, False, True)
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Directed face adjacency of a tiling: (pairs (3, m): box, neighbour, face), on_border (n, 6), edges.
+
+    Row (a, b, f): b lies across face f of a (face 2k: the -axis-k side, 2k + 1: the + side).
+    ``on_border[a, f]``: face f of a lies on the border of the domain along an axis that does not
+    wrap (no neighbour there).  ``edges`` is :func:`shares_face` of the boxes.
+    """
+    level = np.asarray(level, dtype=np.int64)
+    edges = shares_face(level, ijk, depth, periodic=periodic)
+    shift = (depth - level)[:, None]
+    lo, hi = ijk << shift, (ijk + 1) << shift
+    nfine = np.int64(1) << depth
+    a, b = edges
+    rows = []
+    for ax in range(3):
+        others = [o for o in range(3) if o != ax]
+        overlap = np.all(np.minimum(hi[a][:, others], hi[b][:, others]) > np.maximum(lo[a][:, others],
+                                                                                     lo[b][:, others]), axis=1)
+        wrap = nfine if periodic[ax] else np.int64(1) << 62
+        for p, q in ((a, b), (b, a)):
+            m = overlap & ((hi[p, ax] % wrap) == (lo[q, ax] % wrap))  # q across the + face of p
+            rows.append(np.stack([p[m], q[m], np.full(int(m.sum()), 2 * ax + 1)]))
+            rows.append(np.stack([q[m], p[m], np.full(int(m.sum()), 2 * ax)]))
+    pairs = np.concatenate(rows, axis=1)
+    border = np.zeros((len(level), 6), dtype=bool)
+    for ax in range(3):
+        if not periodic[ax]:
+            border[:, 2 * ax] = lo[:, ax] == 0
+            border[:, 2 * ax + 1] = hi[:, ax] == nfine
+    return pairs, border, edges

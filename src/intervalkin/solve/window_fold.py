@@ -49,7 +49,7 @@ from intervalkin.solve.window_count import window_signature
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced", "fold_piece",
-           "extreme_corners"]
+           "extreme_corners", "base_signature", "pair_windows", "pair_slopes"]
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
@@ -111,21 +111,13 @@ def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITI
     those are halved ``halvings`` times to tighten them.
     """
     n = len(models.ok)
-    w = len(models.degree)
     ends = models.end_signs.astype(np.int64)
     firm, even, cusp = _window_kinds(models)
-    constant = firm & (models.degree == 2) & ~even
     cusp = ~firm | cusp  # decided only at points: treated like a cusp window
     box = models.window_box
     n_pair = np.bincount(box, weights=even, minlength=n)
     n_cusp = np.bincount(box, weights=cusp, minlength=n)
-    # the constant part of the signature: the roots off the windows and one root per constant window
-    rising_root = ends[:, 0] < 0
-    det_pos = constant & ((DET_SIGN * models.d_sign.astype(np.int64) * np.where(rising_root, 1, -1)) > 0)
-    base = models.off.copy()
-    base[:, 0] += np.bincount(box, weights=constant, minlength=n).astype(np.int64)
-    base[:, 1] += np.bincount(box, weights=det_pos, minlength=n).astype(np.int64)
-    base[:, 2] += np.bincount(box, weights=constant & ~det_pos, minlength=n).astype(np.int64)
+    base = base_signature(models)
     kind = np.full(n, OPEN, dtype=np.int8)
     clear = models.ok & (n_pair == 0) & (n_cusp == 0)
     kind[clear] = CLEAR
@@ -135,13 +127,7 @@ def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITI
     window[box[pair_w]] = pair_w
     rising = np.zeros((n, 3), dtype=np.int8)
     if pair_w.size:
-        on = np.isin(models.piece_window, pair_w)
-        cand = np.flatnonzero(candidate)
-        row = np.full(n, -1, dtype=np.int64)
-        row[cand] = np.arange(cand.size)
-        rising[box[pair_w]] = _slopes(ReducedBoxes(geometry, models.boxes[cand]), row[box], ends[:, 0], w,
-                                      models.piece_window[on], models.piece_lo[on], models.piece_hi[on],
-                                      halvings)[pair_w]
+        rising[box[pair_w]] = pair_slopes(geometry, models, np.flatnonzero(candidate), halvings)[pair_w]
     edge_rising = np.zeros((n, 2), dtype=np.int8)
     two = np.flatnonzero(candidate & (np.count_nonzero(rising, axis=1) == 2))
     if two.size:
@@ -156,6 +142,48 @@ def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITI
     signature[fold, 0] = base[fold]
     signature[fold, 1] = base[fold] + PAIR
     return WindowFolds(kind, window, rising, signature, edge_rising)
+
+
+def base_signature(models: WindowModels) -> np.ndarray:
+    """(n, 3) the part of each box's signature (count, n_wa1, n_wa2) that is the same at all its points: the roots
+    off the windows and the one root of each window of degree 2 whose end signs differ (box-wide end signs and
+    sign of D); meaningful for modelled boxes."""
+    n = len(models.ok)
+    ends = models.end_signs.astype(np.int64)
+    firm, even, _ = _window_kinds(models)
+    constant = firm & (models.degree == 2) & ~even
+    det_pos = constant & ((DET_SIGN * models.d_sign.astype(np.int64) * np.where(ends[:, 0] < 0, 1, -1)) > 0)
+    box = models.window_box
+    base = models.off.copy()
+    base[:, 0] += np.bincount(box, weights=constant, minlength=n).astype(np.int64)
+    base[:, 1] += np.bincount(box, weights=det_pos, minlength=n).astype(np.int64)
+    base[:, 2] += np.bincount(box, weights=constant & ~det_pos, minlength=n).astype(np.int64)
+    return base
+
+
+def pair_windows(models: WindowModels) -> np.ndarray:
+    """(w,) bool: the pair windows (end signs equal and sign of D, both proved over the whole box: 0 or 2 roots)."""
+    return _window_kinds(models)[1]
+
+
+def pair_slopes(geometry: Geometry, models: WindowModels, rows: np.ndarray,
+                halvings: int = CRITICAL_HALVINGS) -> np.ndarray:
+    """(w, 3) int8 per window of ``models``: for the pair windows of boxes ``rows``, the certified sign of
+    s df/dr_l (s the common end sign) over R^2 x the window's critical pieces, that is the direction in
+    which u = min s f over the window grows along rho_l (0: not certified); 0 for the other windows."""
+    w = len(models.degree)
+    rows = np.asarray(rows, dtype=np.int64)
+    even = pair_windows(models) & np.isin(models.window_box, rows)
+    if not even.any():
+        return np.zeros((w, 3), dtype=np.int8)
+    on = np.isin(models.piece_window, np.flatnonzero(even))
+    row = np.full(len(models.ok), -1, dtype=np.int64)
+    row[rows] = np.arange(rows.size)
+    out = _slopes(ReducedBoxes(geometry, models.boxes[rows]), row[models.window_box],
+                  models.end_signs[:, 0].astype(np.int64), w, models.piece_window[on], models.piece_lo[on],
+                  models.piece_hi[on], halvings)
+    out[~even] = 0
+    return out
 
 
 def _window_kinds(models: WindowModels) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

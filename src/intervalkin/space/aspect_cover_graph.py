@@ -12,44 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from intervalkin.paving.adjacency import component_labels, grow_labels, shares_face, touching_pairs
+from intervalkin.paving.adjacency import component_labels, directed_face_pairs as face_pairs, grow_labels, shares_face, touching_pairs
 from intervalkin.space.aspect_retraction import DIRECTIONS, exit_faces
 
 __all__ = ["OUT", "SINK", "RET", "LEFT", "face_pairs", "resolve_cover", "separations", "between_groups"]
 
 #: Kinds of the boxes of a cover.
 OUT, SINK, RET, LEFT = 0, 1, 2, 3
-
-
-def face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Directed face adjacency of a tiling: (pairs (3, m): box, neighbour, face), on_border (n, 6), edges.
-
-    Row (a, b, f): b lies across face f of a (face 2k: -axis-k side, 2k + 1: + side; phi wraps).
-    ``on_border[a, f]``: face f of a lies on the x or y border of the domain (no neighbour there).
-    ``edges`` is :func:`~intervalkin.paving.adjacency.shares_face` of the boxes.
-    """
-    level = np.asarray(level, dtype=np.int64)
-    edges = shares_face(level, ijk, depth)
-    shift = (depth - level)[:, None]
-    lo, hi = ijk << shift, (ijk + 1) << shift
-    nfine = np.int64(1) << depth
-    a, b = edges
-    rows = []
-    for ax in range(3):
-        others = [o for o in range(3) if o != ax]
-        overlap = np.all(np.minimum(hi[a][:, others], hi[b][:, others]) > np.maximum(lo[a][:, others],
-                                                                                     lo[b][:, others]), axis=1)
-        wrap = nfine if ax == 2 else np.int64(1) << 62
-        for p, q in ((a, b), (b, a)):
-            m = overlap & ((hi[p, ax] % wrap) == (lo[q, ax] % wrap))  # q across the + face of p
-            rows.append(np.stack([p[m], q[m], np.full(int(m.sum()), 2 * ax + 1)]))
-            rows.append(np.stack([q[m], p[m], np.full(int(m.sum()), 2 * ax)]))
-    pairs = np.concatenate(rows, axis=1)
-    border = np.zeros((len(level), 6), dtype=bool)
-    for ax in range(2):
-        border[:, 2 * ax] = lo[:, ax] == 0
-        border[:, 2 * ax + 1] = hi[:, ax] == nfine
-    return pairs, border, edges
 
 
 def resolve_cover(level, ijk, depth, out, inside, ok, custom_faces, volume, max_groups: int = 1, adjacency=None):

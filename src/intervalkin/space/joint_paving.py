@@ -63,6 +63,7 @@ from intervalkin.space.joint_leaves import adaptive_leaves, leaves_to_paving, re
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
 from intervalkin.space.joint_models import ModelStore
 from intervalkin.space.joint_pieces import FoldPieces, PieceSignatures, piece_signatures
+from intervalkin.space.joint_retraction import JointRetraction
 from intervalkin.space.joint_places import WHY_OPEN, open_leaves, open_places, place_labels, why_counts
 from intervalkin.space.joint_window_pieces import (check_window_cells, signatures_from_windows, window_cell_of,
                                                    window_columns, window_pieces)
@@ -104,6 +105,8 @@ class JointSpacePaving:
         of g(S); :mod:`intervalkin.space.joint_windows`): a certified signature at each of their points;
         the window-clear leaves and window folds among them are also cut into proved pieces.
     window_cell : (2 k,) the cell of each window piece (piece s of window row j at 2 j + s), -1 where none.
+    retraction : the nodes of the leaves and their retraction ranks towards the cells, the local step of an
+        upper bound (set by :func:`~intervalkin.space.joint_topology.pave_joint_topology`).
     """
 
     paving: Paving
@@ -117,6 +120,8 @@ class JointSpacePaving:
     piece_signatures: PieceSignatures | None = None
     windows: JointWindows | None = None
     window_cell: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int32))
+    #: the open layer's retraction into the cells (:mod:`intervalkin.space.joint_retraction`), when computed
+    retraction: JointRetraction | None = None
 
     def counted_fold_mask(self) -> np.ndarray:
         """(n,) bool: the leaves that are fold boxes each of whose pieces has a certified signature or is empty."""
@@ -144,7 +149,8 @@ class JointSpacePaving:
                            "why": WHY_OPEN,
                            "by_reason": {name: {"leaves": k, "volume": v} for name, k, v in
                                          why_counts(reason[open_leaf], p.volume()[open_leaf])},
-                           "largest": [q.to_json() for q in largest]}}
+                           "largest": [q.to_json() for q in largest]},
+                **({} if self.retraction is None else {"retraction": self.retraction.to_json(p.volume())})}
 
     def pieced_mask(self) -> np.ndarray:
         """(n,) bool: window-clear leaves and window folds (their pieces' signatures are fixed by their models)."""

@@ -1,0 +1,313 @@
+"""Retraction of the joint paving's open layer into its cells: the local step of an upper bound on the cells.
+
+Fix a signature sigma = (count, n_wa1, n_wa2) and let U be the set of joint vectors of the joint box
+whose direct kinematics has signature sigma.  The cells of the paving
+(:mod:`intervalkin.space.joint_cells`) with signature sigma are connected subsets of U.  Each leaf's
+part of U is covered by NODES, sets on which the signature is known at every point:
+
+* a clear leaf: one node, its closed box;
+* a fold box (:mod:`intervalkin.solve.fold_model`): the piece below the graph rho_k = h and the one above;
+* a window-clear leaf or a window fold (:mod:`intervalkin.solve.window_fold`): its one or two pieces;
+* a window-modelled leaf whose windows are pair windows (end signs and sign of D proved over the box:
+  0 or 2 roots) besides windows of fixed count: one node per PATTERN, which pair windows hold their two roots.
+
+A node is a SINK when it lies in a counted cell (a clear leaf of it, or a piece joined to it).  A node
+RETRACTS through face f of its leaf, of outward normal d e_l, when moving along d e_l keeps every point
+of the node in it up to the face:
+
+* a node of a clear leaf: through every face (the signature is the same on the whole box);
+* the fold piece below: through the -e_k face; the piece above: through the +e_k face;
+* a pattern node: through the d e_l face when, for each pair window i, the slope c_il (the certified
+  sign of s df/dr_l over the window's critical pieces, :func:`~intervalkin.solve.window_fold.pair_slopes`)
+  is not zero and d = c_il where window i is empty (u_i = min s f > 0 grows), d = -c_il where it holds two
+  roots (u_i < 0 falls); the other roots are the same on the whole box.
+
+RANKS (a fixed point): a node is resolved at rank r >= 1 when, for some face f it retracts through that is not
+on the border of the joint box, every leaf across f is modelled (no LEFT node of unknown signature) and
+each of its nodes with the same signature is a sink or resolved at a rank below r.
+
+Upper bound (proofs/lemma-joint-retraction.md): a point of U in a resolved node moves inside U to a face
+point, which lies in a node of signature sigma of a leaf across that face, of lower rank; so every point of
+U is joined inside U to a cell of signature sigma.  When every node is a sink or resolved, U has at most as
+many components as the paving has counted cells of signature sigma, and the number of basic regions is at
+most the sum of the cells' counts.  Certified: the nodes' sets come from the proved models (their
+signatures are those the paving proved); the slopes are outward-rounded enclosures.  Leaves near a cusp
+edge of g(S) (a window of one or three roots), windows decided only at points, and leaves with no model
+are LEFT: they block every node that would retract into them, so with any of them in the way no upper
+bound is claimed.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from intervalkin.core.geometry import Geometry
+from intervalkin.paving.adjacency import directed_face_pairs
+from intervalkin.solve.window_fold import CLEAR, FOLD, PAIR, base_signature, pair_slopes, pair_windows
+
+__all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_PAIR_WINDOWS", "JointRetraction", "retract_joint_paving"]
+
+#: Kinds of nodes.
+SINK, RET, LEFT = 0, 1, 2
+#: What a node is: a clear leaf, a fold piece, a window piece (window-clear leaf or window fold), a pattern of
+#: pair windows, or a LEFT leaf with no model of its pieces (its signature unknown).
+SOURCES = ("clear", "fold_piece", "window_piece", "pair_pattern", "no_piece_model")
+#: Window-modelled leaves with more pair windows than this are LEFT (2**k patterns each).
+MAX_PAIR_WINDOWS = 3
+_ALL_FACES = np.ones(6, dtype=bool)
+
+
+@dataclass(frozen=True, eq=False)
+class JointRetraction:
+    """The nodes of a joint paving's leaves and their retraction ranks.
+
+    leaf : (v,) int64, sorted: the leaf of each node.
+    signature : (v, 3) int64, (count, n_wa1, n_wa2) at every point of the node; -1 for a LEFT node of
+        unknown signature (it may hold points of any signature).
+    kind : (v,) int8, SINK, RET or LEFT.
+    source : (v,) int8, an index into :data:`SOURCES`.
+    cell : (v,) int32, the counted cell of a sink, -1 for the others.
+    faces : (v, 6) bool, the faces a RET node retracts through (face 2l: the -e_l side, 2l + 1: +e_l).
+    rank : (v,) int32, 0 for sinks, r >= 1 for resolved RET nodes, -1 for the others.
+    exit : (v,) int8, the face through which a resolved node retracts (-1 elsewhere).
+    seconds : the time taken.
+    """
+
+    leaf: np.ndarray
+    signature: np.ndarray
+    kind: np.ndarray
+    source: np.ndarray
+    cell: np.ndarray
+    faces: np.ndarray
+    rank: np.ndarray
+    exit: np.ndarray
+    seconds: float
+
+    @property
+    def unresolved(self) -> np.ndarray:
+        """(v,) bool: the nodes that are neither sinks nor resolved (LEFT nodes included)."""
+        return self.rank < 0
+
+    def closed(self) -> bool:
+        """Every node is a sink or resolved: every point off g(S) is joined to a counted cell of its signature."""
+        return not self.unresolved.any()
+
+    def leaves_left(self, n: int) -> np.ndarray:
+        """(n,) bool over the paving's leaves: those holding an unresolved node."""
+        out = np.zeros(n, dtype=bool)
+        out[self.leaf[self.unresolved]] = True
+        return out
+
+    def to_json(self, volume: np.ndarray) -> dict:
+        """Figures of the retraction for summary.json; ``volume`` (n,) the paving's leaf volumes."""
+        left = self.unresolved
+        by_source = {}
+        for code, name in enumerate(SOURCES):
+            at = self.source == code
+            if at.any():
+                leaves = np.unique(self.leaf[at & left])
+                by_source[name] = {"nodes": int(at.sum()), "unresolved": int((at & left).sum()),
+                                   "leaves_unresolved": int(leaves.size), "volume_unresolved": float(volume[leaves].sum())}
+        leaves = np.unique(self.leaf[left])
+        return {"closed": self.closed(), "nodes": int(self.leaf.size), "sinks": int((self.kind == SINK).sum()),
+                "resolved": int(((self.kind == RET) & ~left).sum()), "unresolved": int(left.sum()),
+                "leaves_unresolved": int(leaves.size), "volume_unresolved": float(volume[leaves].sum()),
+                "largest_rank": int(self.rank.max(initial=0)), "by_source": by_source,
+                "seconds": round(self.seconds, 2)}
+
+
+def _faces_of_axis(rising: np.ndarray, towards: np.ndarray) -> np.ndarray:
+    """(m, 6) bool: for each axis l with rising[:, l] != 0, the face on the side of sign towards * rising."""
+    out = np.zeros((len(rising), 6), dtype=bool)
+    for ax in range(3):
+        d = rising[:, ax].astype(np.int64) * towards
+        out[:, 2 * ax] = d < 0
+        out[:, 2 * ax + 1] = d > 0
+    return out
+
+
+class _Nodes:
+    """The node table, filled source by source."""
+
+    def __init__(self):
+        self.parts: list[tuple] = []
+
+    def add(self, leaf, signature, kind, source, cell, faces):
+        leaf = np.asarray(leaf, dtype=np.int64)
+        m = leaf.size
+        kind = np.broadcast_to(np.asarray(kind, dtype=np.int8), (m,))
+        cell = np.broadcast_to(np.asarray(cell, dtype=np.int32), (m,))
+        faces = np.broadcast_to(np.asarray(faces, dtype=bool), (m, 6))
+        self.parts.append((leaf, np.asarray(signature, dtype=np.int64).reshape(m, 3), kind,
+                           np.full(m, source, dtype=np.int8), cell, faces))
+
+    def table(self):
+        cols = [np.concatenate([p[i] for p in self.parts]) for i in range(6)]
+        order = np.argsort(cols[0], kind="stable")
+        return [c[order] for c in cols]
+
+
+def _cell_of_piece(piece_cell: np.ndarray, counted: int) -> np.ndarray:
+    return np.where((piece_cell >= 0) & (piece_cell < counted), piece_cell, -1)
+
+
+def _kind(cell: np.ndarray, signature: np.ndarray) -> np.ndarray:
+    """SINK where joined to a counted cell, RET where the signature is known, LEFT elsewhere."""
+    return np.where(cell >= 0, SINK, np.where(signature[:, 0] >= 0, RET, LEFT)).astype(np.int8)
+
+
+def _clear_nodes(jp, nodes: _Nodes) -> None:
+    every = jp.cells + jp.fragments
+    sig = np.array([c.signature for c in every] or np.zeros((0, 3)), dtype=np.int64).reshape(-1, 3)
+    leaf = np.flatnonzero(jp.cell >= 0)
+    c = jp.cell[leaf].astype(np.int64)
+    s = sig[c]
+    cell = np.where(c < len(jp.cells), c, -1)
+    nodes.add(leaf, s, _kind(cell, s), 0, cell, _ALL_FACES)
+
+
+def _fold_nodes(jp, nodes: _Nodes) -> None:
+    pieces, sigs = jp.pieces, jp.piece_signatures
+    if pieces is None or not len(pieces) or sigs is None:
+        return
+    axis = pieces.models.axis.astype(np.int64)
+    for side in (0, 1):  # below: towards -e_k; above: towards +e_k
+        keep = sigs.empty != (-1 if side == 0 else 1)
+        s = sigs.signature[keep, side]
+        cell = _cell_of_piece(jp.piece_cell[2 * np.flatnonzero(keep) + side], len(jp.cells))
+        faces = np.zeros((int(keep.sum()), 6), dtype=bool)
+        faces[np.arange(faces.shape[0]), 2 * axis[keep] + side] = True
+        nodes.add(pieces.box[keep], s, _kind(cell, s), 1, cell, faces)
+
+
+def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
+    """Nodes of the window-modelled leaves; returns the rows left without nodes (their leaves are LEFT)."""
+    win = jp.windows
+    if win is None or win.folds is None:
+        return np.zeros(0, dtype=np.int64)
+    models, folds, counted = win.models, win.folds, len(jp.cells)
+    for code, sides in ((CLEAR, (0,)), (FOLD, (0, 1))):
+        rows = np.flatnonzero(folds.kind == code)
+        for side in sides:
+            s = folds.signature[rows, side]
+            cell = _cell_of_piece(jp.window_cell[2 * rows + side], counted)
+            faces = (np.ones((rows.size, 6), dtype=bool) if code == CLEAR
+                     else _faces_of_axis(folds.rising[rows], np.int64(1 - 2 * side)))
+            nodes.add(win.leaf[rows], s, _kind(cell, s), 2, cell, faces)
+    # the other modelled rows: pair windows only (besides windows of fixed count), a node per pattern
+    pair = pair_windows(models)
+    box = models.window_box
+    n = len(models.ok)
+    only_pairs = np.bincount(box, weights=~pair & ~_constant(models), minlength=n) == 0
+    n_pair = np.bincount(box, weights=pair, minlength=n)
+    rows = np.flatnonzero(models.ok & ~np.isin(folds.kind, (CLEAR, FOLD)) & only_pairs
+                          & (n_pair >= 1) & (n_pair <= MAX_PAIR_WINDOWS))
+    if rows.size:
+        slope = pair_slopes(geometry, models, rows)
+        base = base_signature(models)
+        for k in range(1, MAX_PAIR_WINDOWS + 1):
+            rk = rows[n_pair[rows] == k]
+            if not rk.size:
+                continue
+            wins = np.flatnonzero(pair & np.isin(box, rk)).reshape(rk.size, k)  # windows are sorted by box
+            c = slope[wins].astype(np.int64)  # (m, k, 3)
+            for pattern in range(1 << k):
+                real = np.array([(pattern >> i) & 1 for i in range(k)], dtype=np.int64)
+                towards = (1 - 2 * real)[None, :, None] * c  # the direction each window allows, per axis
+                ok = (towards != 0).all(axis=1) & (towards == towards[:, :1, :]).all(axis=1)
+                faces = _faces_of_axis(np.where(ok, towards[:, 0, :], 0), np.int64(1))
+                s = base[rk] + int(real.sum()) * PAIR
+                nodes.add(win.leaf[rk], s, RET, 3, -1, faces)
+    done = np.isin(folds.kind, (CLEAR, FOLD))
+    done[rows] = True
+    return np.flatnonzero(~done)
+
+
+def _constant(models) -> np.ndarray:
+    """(w,) bool: windows of degree 2 with box-wide end signs that differ and sign of D (exactly one root)."""
+    ends = models.end_signs.astype(np.int64)
+    return ((ends != 0).all(axis=1) & (models.d_sign != 0) & (models.degree == 2) & (ends[:, 0] != ends[:, 1]))
+
+
+def retract_joint_paving(jp, geometry: Geometry) -> JointRetraction:
+    """The nodes of the leaves of ``jp`` (a :class:`~intervalkin.space.joint_paving.JointSpacePaving`) and
+    their retraction ranks (module docstring)."""
+    t0 = time.perf_counter()
+    n = len(jp.cell)
+    nodes = _Nodes()
+    _clear_nodes(jp, nodes)
+    _fold_nodes(jp, nodes)
+    left_rows = _window_nodes(jp, geometry, nodes)
+    covered = np.zeros(n, dtype=bool)
+    for part in nodes.parts:
+        covered[part[0]] = True
+    if jp.windows is not None:
+        covered[jp.windows.leaf[left_rows]] = False  # a window row without nodes: its leaf is LEFT
+    left = np.flatnonzero(~covered)
+    nodes.add(left, -np.ones((left.size, 3)), LEFT, 4, -1, np.zeros(6, dtype=bool))
+    leaf, sig, kind, source, cell, faces = nodes.table()
+    rank, exit_ = _ranks(jp.paving, leaf, sig, kind, faces)
+    return JointRetraction(leaf, sig, kind, source, cell, faces, rank, exit_, time.perf_counter() - t0)
+
+
+def _ranks(paving, leaf, sig, kind, faces) -> tuple[np.ndarray, np.ndarray]:
+    """The fixed point of the ranks (module docstring), a worklist over (node, face) entries."""
+    v = leaf.size
+    n = len(paving.level)
+    pairs, border, _ = directed_face_pairs(paving.level, paving.ijk, paving.depth, periodic=(False, False, False))
+    start = np.searchsorted(leaf, np.arange(n + 1))
+    # (node, face) entries of RET nodes, not on the border
+    p_node, p_face = np.nonzero(faces & (kind == RET)[:, None])
+    keep = ~border[leaf[p_node], p_face]
+    p_node, p_face = p_node[keep], p_face[keep]
+    # leaf pairs across each face, looked up by (leaf, face)
+    key = pairs[0] * 6 + pairs[2]
+    order = np.argsort(key, kind="stable")
+    key, across = key[order], pairs[1][order]
+    e_lo = np.searchsorted(key, leaf[p_node] * 6 + p_face)
+    e_hi = np.searchsorted(key, leaf[p_node] * 6 + p_face, side="right")
+    entry = np.repeat(np.arange(p_node.size), e_hi - e_lo)
+    nb = across[np.repeat(e_lo, e_hi - e_lo) + _ramp(e_hi - e_lo)]
+    # the nodes of each neighbour leaf that the entry waits for: same signature, or of unknown signature
+    q = np.repeat(start[nb], start[nb + 1] - start[nb]) + _ramp(start[nb + 1] - start[nb])
+    entry = np.repeat(entry, start[nb + 1] - start[nb])
+    wait = (sig[q, 0] < 0) | (sig[q] == sig[p_node[entry]]).all(axis=1)
+    wait &= kind[q] != SINK
+    entry, q = entry[wait], q[wait]
+    pending = np.bincount(entry, minlength=p_node.size)
+    by_q = np.argsort(q, kind="stable")
+    q_sorted, entry_by_q = q[by_q], entry[by_q]
+    rank = np.where(kind == SINK, 0, -1).astype(np.int32)
+    exit_ = np.full(v, -1, dtype=np.int8)
+    ready = np.flatnonzero(pending == 0)
+    r = 0
+    while ready.size:
+        r += 1
+        fresh = p_node[ready]
+        fresh_new = rank[fresh] < 0
+        ready, fresh = ready[fresh_new], fresh[fresh_new]
+        fresh, first = np.unique(fresh, return_index=True)
+        if not fresh.size:
+            break
+        rank[fresh] = r
+        exit_[fresh] = p_face[ready[first]]
+        lo = np.searchsorted(q_sorted, fresh)
+        hi = np.searchsorted(q_sorted, fresh, side="right")
+        hit = entry_by_q[np.repeat(lo, hi - lo) + _ramp(hi - lo)]
+        np.subtract.at(pending, hit, 1)
+        hit = np.unique(hit)
+        ready = hit[(pending[hit] == 0) & (rank[p_node[hit]] < 0)]
+    return rank, exit_
+
+
+def _ramp(lengths: np.ndarray) -> np.ndarray:
+    """0, 1, ..., len - 1 for each length in turn."""
+    lengths = np.asarray(lengths, dtype=np.int64)
+    total = int(lengths.sum())
+    if total == 0:
+        return np.zeros(0, dtype=np.int64)
+    starts = np.repeat(np.cumsum(lengths) - lengths, lengths)
+    return np.arange(total, dtype=np.int64) - starts

@@ -1,0 +1,169 @@
+"""The open layer's retraction into the cells (space.joint_retraction, proofs/lemma-joint-retraction.md)."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from intervalkin.solve.dkp import solve
+from intervalkin.space.joint_retraction import LEFT, RET, SINK, SOURCES, _ranks, retract_joint_paving
+
+
+@pytest.fixture(scope="module")
+def retraction(fold_paving, paper_geometry):
+    return retract_joint_paving(fold_paving, paper_geometry)
+
+
+def _signature(geometry, point) -> tuple[int, int, int] | None:
+    """The signature at an exact point from an independent certified solve, None where it does not complete."""
+    res = solve(geometry, [Fraction(float(x)) for x in point])
+    if not res.complete or any(s.status != "unique" or s.det_sign == 0 for s in res.solutions):
+        return None
+    n1 = sum(s.det_sign > 0 for s in res.solutions)
+    return len(res.solutions), n1, len(res.solutions) - n1
+
+
+def test_every_leaf_has_a_node_and_sinks_lie_in_counted_cells(fold_paving, retraction):
+    r = retraction
+    assert np.all(np.diff(r.leaf) >= 0)
+    assert np.array_equal(np.unique(r.leaf), np.arange(len(fold_paving.cell)))
+    sink = r.kind == SINK
+    assert sink.any() and np.all(r.cell[sink] >= 0) and np.all(r.cell[sink] < len(fold_paving.cells))
+    assert np.all(r.cell[~sink] == -1) and np.all(r.rank[sink] == 0)
+    # a sink's signature is its cell's
+    sigs = np.array([c.signature for c in fold_paving.cells])
+    assert np.array_equal(r.signature[sink], sigs[r.cell[sink]])
+    # every source of node occurs on this paving, and LEFT nodes never get a rank
+    assert set(np.unique(r.source)) == set(range(len(SOURCES)))
+    assert np.all(r.rank[r.kind == LEFT] == -1)
+    assert not r.closed()  # cusp windows are LEFT: no upper bound at this depth
+
+
+def test_ranks_follow_the_rule_across_each_exit_face(fold_paving, retraction):
+    """Re-derived from the float boxes: every leaf sharing a 2-D piece of a resolved node's exit face holds no LEFT
+    node, and its nodes of the same signature are sinks or of lower rank."""
+    r, p = retraction, fold_paving.paving
+    lo, hi = p.lo, p.hi
+    resolved = np.flatnonzero((r.kind == RET) & (r.rank > 0))
+    assert resolved.size > 100
+    rng = np.random.default_rng(5)
+    start = np.searchsorted(r.leaf, np.arange(len(lo) + 1))
+    for node in rng.choice(resolved, 300, replace=False):
+        f = int(r.exit[node])
+        assert r.faces[node, f]
+        ax, side = divmod(f, 2)
+        a = r.leaf[node]
+        plane = hi[a, ax] if side else lo[a, ax]
+        assert p.domain[ax, 0] < plane < p.domain[ax, 1]  # not on the border
+        others = [o for o in range(3) if o != ax]
+        touch = (lo[:, ax] == plane) if side else (hi[:, ax] == plane)
+        for o in others:
+            touch &= (np.minimum(hi[:, o], hi[a, o]) > np.maximum(lo[:, o], lo[a, o]))
+        across = np.flatnonzero(touch)
+        assert across.size >= 1
+        for b in across:
+            q = np.arange(start[b], start[b + 1])
+            assert not np.any(r.kind[q] == LEFT)
+            same = q[(r.signature[q] == r.signature[node]).all(axis=1)]
+            assert np.all((r.rank[same] >= 0) & (r.rank[same] < r.rank[node]))
+
+
+def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retraction, paper_geometry):
+    """Property test against independent certified solves: a point of a resolved node (of a signature no other node
+    of its leaf has) keeps the node's signature on the segment along the exit direction up to the face."""
+    r, p = retraction, fold_paving.paving
+    rng = np.random.default_rng(11)
+    checked = {name: 0 for name in SOURCES}
+    for source in (1, 2, 3):
+        nodes = np.flatnonzero((r.source == source) & (r.rank > 0))
+        rng.shuffle(nodes)
+        for node in nodes[:150]:
+            a = r.leaf[node]
+            mates = np.flatnonzero(r.leaf == a)
+            if ((r.signature[mates] == r.signature[node]).all(axis=1)).sum() != 1:
+                continue
+            for _ in range(6):  # a point of the node: one of the node's signature (no other node of the leaf has it)
+                x = p.lo[a] + rng.random(3) * (p.hi[a] - p.lo[a])
+                if _signature(paper_geometry, x) == tuple(r.signature[node]):
+                    break
+            else:
+                continue
+            ax, side = divmod(int(r.exit[node]), 2)
+            end = p.hi[a, ax] if side else p.lo[a, ax]
+            for t in (0.25, 0.5, 0.75, 1.0):
+                y = x.copy()
+                y[ax] = x[ax] + t * (end - x[ax])
+                got = _signature(paper_geometry, y)
+                assert got is None or got == tuple(r.signature[node]), (SOURCES[source], node, y)
+            checked[SOURCES[source]] += 1
+    assert checked["fold_piece"] >= 10 and checked["window_piece"] >= 2 and checked["pair_pattern"] >= 20, checked
+
+
+def _cube(depth: int):
+    n = 2 ** depth
+    ijk = np.array([(i, j, k) for i in range(n) for j in range(n) for k in range(n)], dtype=np.int64)
+    return SimpleNamespace(level=np.full(len(ijk), depth), ijk=ijk, depth=depth)
+
+
+def _faces(*which):
+    out = np.zeros(6, dtype=bool)
+    out[list(which)] = True
+    return out
+
+
+def test_the_fixed_point_on_a_small_tiling():
+    """A row of boxes along x retracting towards a sink at x = 0 is ranked 1, 2, 3; a LEFT box or a box of
+    unknown signature blocks; a face on the border never counts; two boxes retracting into each other stay
+    unresolved; a neighbour of another signature does not block."""
+    t = _cube(2)
+    n = len(t.ijk)
+    at = {tuple(v): i for i, v in enumerate(t.ijk)}
+    sig = np.ones((n, 3), dtype=np.int64)
+    kind = np.full(n, SINK, dtype=np.int8)
+    faces = np.zeros((n, 6), dtype=bool)
+    row = [at[(i, 0, 0)] for i in range(4)]
+    kind[row[1:]] = RET
+    faces[row[1:]] = _faces(0)  # towards -x
+    # a cycle: (1, 2, 0) retracts +x into (2, 2, 0), which retracts -x back
+    c1, c2 = at[(1, 2, 0)], at[(2, 2, 0)]
+    kind[[c1, c2]] = RET
+    faces[c1], faces[c2] = _faces(1), _faces(0)
+    # the border: (0, 3, 3) retracts only through its -x face, which is on the border
+    b = at[(0, 3, 3)]
+    kind[b] = RET
+    faces[b] = _faces(0)
+    # a box behind a LEFT leaf, one behind a neighbour of another signature
+    left, behind = at[(0, 1, 3)], at[(1, 1, 3)]
+    kind[left], sig[left] = LEFT, -1
+    kind[behind], faces[behind] = RET, _faces(0)
+    other, past = at[(0, 3, 1)], at[(1, 3, 1)]
+    kind[other] = RET
+    sig[other] = (3, 2, 1)  # never resolved (its only face is on the border) but of another signature
+    faces[other] = _faces(0)
+    kind[past], faces[past] = RET, _faces(0)
+    leaf = np.arange(n)
+    rank, exit_ = _ranks(t, leaf, sig, kind, faces)
+    assert list(rank[row]) == [0, 1, 2, 3] and list(exit_[row[1:]]) == [0, 0, 0]
+    assert rank[c1] == -1 and rank[c2] == -1
+    assert rank[b] == -1 and rank[other] == -1
+    assert rank[left] == -1 and rank[behind] == -1
+    assert rank[past] == 1
+    # with the LEFT leaf made a sink of the same signature, the box behind it resolves
+    kind[left], sig[left] = SINK, 1
+    rank, _ = _ranks(t, leaf, sig, kind, faces)
+    assert rank[behind] == 1
+
+
+def test_the_summary_reports_the_retraction(fold_paving, retraction):
+    from dataclasses import replace
+
+    block = replace(fold_paving, retraction=retraction).open_places()["retraction"]
+    assert block["closed"] is False
+    assert block["nodes"] == retraction.leaf.size
+    assert block["sinks"] + block["resolved"] + block["unresolved"] == block["nodes"]
+    assert sum(v["unresolved"] for v in block["by_source"].values()) == block["unresolved"]
+    assert 0 < block["volume_unresolved"] <= fold_paving.paving.volume().sum()
+    assert "retraction" not in fold_paving.open_places()
