@@ -51,24 +51,24 @@ def test_ranks_follow_the_rule_across_each_exit_face(fold_paving, retraction):
     assert resolved.size > 100
     rng = np.random.default_rng(5)
     start = np.searchsorted(r.leaf, np.arange(len(lo) + 1))
+    bits = (r.option_faces * (1 << np.arange(6))).sum(axis=1)
     for node in rng.choice(resolved, 300, replace=False):
-        f = int(r.exit[node])
-        assert r.faces[node, f]
-        ax, side = divmod(f, 2)
+        assert np.any((r.option_node == node) & (bits == r.exit[node]))  # the exit is one of the node's options
         a = r.leaf[node]
-        plane = hi[a, ax] if side else lo[a, ax]
-        assert p.domain[ax, 0] < plane < p.domain[ax, 1]  # not on the border
-        others = [o for o in range(3) if o != ax]
-        touch = (lo[:, ax] == plane) if side else (hi[:, ax] == plane)
-        for o in others:
-            touch &= (np.minimum(hi[:, o], hi[a, o]) > np.maximum(lo[:, o], lo[a, o]))
-        across = np.flatnonzero(touch)
-        assert across.size >= 1
-        for b in across:
-            q = np.arange(start[b], start[b + 1])
-            assert not np.any(r.kind[q] == LEFT)
-            same = q[(r.signature[q] == r.signature[node]).all(axis=1)]
-            assert np.all((r.rank[same] >= 0) & (r.rank[same] < r.rank[node]))
+        for f in np.flatnonzero((int(r.exit[node]) >> np.arange(6)) & 1):
+            ax, side = divmod(int(f), 2)
+            plane = hi[a, ax] if side else lo[a, ax]
+            assert p.domain[ax, 0] < plane < p.domain[ax, 1]  # not on the border
+            touch = (lo[:, ax] == plane) if side else (hi[:, ax] == plane)
+            for o in [o for o in range(3) if o != ax]:
+                touch &= (np.minimum(hi[:, o], hi[a, o]) > np.maximum(lo[:, o], lo[a, o]))
+            across = np.flatnonzero(touch)
+            assert across.size >= 1
+            for b in across:
+                q = np.arange(start[b], start[b + 1])
+                assert not np.any(r.kind[q] == LEFT)
+                same = q[(r.signature[q] == r.signature[node]).all(axis=1)]
+                assert np.all((r.rank[same] >= 0) & (r.rank[same] < r.rank[node]))
 
 
 def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retraction, paper_geometry):
@@ -91,7 +91,7 @@ def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retract
                     break
             else:
                 continue
-            ax, side = divmod(int(r.exit[node]), 2)
+            ax, side = divmod(int(np.log2(int(r.exit[node]))), 2)  # one face: a straight retraction
             end = p.hi[a, ax] if side else p.lo[a, ax]
             for t in (0.25, 0.5, 0.75, 1.0):
                 y = x.copy()
@@ -145,16 +145,24 @@ def test_the_fixed_point_on_a_small_tiling():
     faces[other] = _faces(0)
     kind[past], faces[past] = RET, _faces(0)
     leaf = np.arange(n)
-    rank, exit_ = _ranks(t, leaf, sig, kind, faces)
-    assert list(rank[row]) == [0, 1, 2, 3] and list(exit_[row[1:]]) == [0, 0, 0]
+    opt_node, opt_face = np.nonzero(faces & (kind == RET)[:, None])
+    rank, exit_ = _ranks(t, leaf, sig, kind, opt_node, np.eye(6, dtype=bool)[opt_face])
+    assert list(rank[row]) == [0, 1, 2, 3] and list(exit_[row[1:]]) == [1, 1, 1]  # bit 0: the -x face
     assert rank[c1] == -1 and rank[c2] == -1
     assert rank[b] == -1 and rank[other] == -1
     assert rank[left] == -1 and rank[behind] == -1
     assert rank[past] == 1
     # with the LEFT leaf made a sink of the same signature, the box behind it resolves
     kind[left], sig[left] = SINK, 1
-    rank, _ = _ranks(t, leaf, sig, kind, faces)
+    rank, _ = _ranks(t, leaf, sig, kind, opt_node, np.eye(6, dtype=bool)[opt_face])
     assert rank[behind] == 1
+    # an option of two faces needs both: (2, 1, 3) through -x (the resolved (1, 1, 3)) and +x (unresolved (3, 1, 3))
+    two = at[(2, 1, 3)]
+    kind[two] = RET
+    kind[at[(3, 1, 3)]], faces[at[(3, 1, 3)]] = RET, _faces(1)  # its only face on the border
+    both = np.array([[True, True, False, False, False, False]])
+    rank, _ = _ranks(t, leaf, sig, kind, np.r_[opt_node, two], np.r_[np.eye(6, dtype=bool)[opt_face], both])
+    assert rank[at[(1, 1, 3)]] == 1 and rank[two] == -1
 
 
 def test_the_summary_reports_the_retraction(fold_paving, retraction):

@@ -168,15 +168,16 @@ class ReducedBoxes:
         return mv.intersect(natural)
 
 
-    def r_slope(self, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray, axis: int) -> Interval:
-        """Enclosure of d f / d r_axis over (box owner, piece [lo, hi]), r_axis = rho_axis^2.
+    def r_slope(self, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray, axis: int, deriv: int = 0) -> Interval:
+        """Enclosure of d^(1 + deriv) f / d r_axis d phi^deriv over (box owner, piece [lo, hi]), r_axis = rho_axis^2.
 
         d c_h / d r_axis is affine in r: its value at r_c (a row of the Taylor data) plus
-        sum_i (d^2 c_h / d r_axis d r_i) d_i with |d_i| <= h_i; natural form in phi.
+        sum_i (d^2 c_h / d r_axis d r_i) d_i with |d_i| <= h_i; natural form in phi (the basis
+        differentiated ``deriv`` times).
         """
         taylor = self.taylor[owner]
         half = self.half[owner]
-        w = _basis(Ball.from_interval(Interval(lo, hi)), 0)
+        w = _basis(Ball.from_interval(Interval(lo, hi)), deriv)
         t = w.dot_rows(taylor)  # (m, 4)
         q = w.matmul(Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy()))  # (m, 6)
         quad = [e for e in MONOMIALS if len(e) == 2]

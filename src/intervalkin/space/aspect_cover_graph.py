@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from intervalkin.paving.adjacency import component_labels, directed_face_pairs as face_pairs, grow_labels, shares_face, touching_pairs
+from intervalkin.paving.adjacency import component_labels, directed_face_pairs as face_pairs, grow_labels, touching_pairs
 from intervalkin.space.aspect_retraction import DIRECTIONS, exit_faces
 
 __all__ = ["OUT", "SINK", "RET", "LEFT", "face_pairs", "resolve_cover", "separations", "between_groups"]

@@ -46,6 +46,7 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.paving.adjacency import directed_face_pairs
+from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
 from intervalkin.solve.window_fold import CLEAR, FOLD, PAIR, base_signature, pair_slopes, pair_windows
 
 __all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_PAIR_WINDOWS", "JointRetraction", "retract_joint_paving"]
@@ -53,11 +54,12 @@ __all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_PAIR_WINDOWS", "JointRetractio
 #: Kinds of nodes.
 SINK, RET, LEFT = 0, 1, 2
 #: What a node is: a clear leaf, a fold piece, a window piece (window-clear leaf or window fold), a pattern of
-#: pair windows, or a LEFT leaf with no model of its pieces (its signature unknown).
-SOURCES = ("clear", "fold_piece", "window_piece", "pair_pattern", "no_piece_model")
+#: pair windows, a side of a cusp window (one root or three), or a LEFT leaf with no model of its pieces (its
+#: signature unknown).
+SOURCES = ("clear", "fold_piece", "window_piece", "pair_pattern", "cusp_side", "no_piece_model")
 #: Window-modelled leaves with more pair windows than this are LEFT (2**k patterns each).
 MAX_PAIR_WINDOWS = 3
-_ALL_FACES = np.ones(6, dtype=bool)
+_EACH_FACE = np.eye(6, dtype=bool)
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,9 +72,10 @@ class JointRetraction:
     kind : (v,) int8, SINK, RET or LEFT.
     source : (v,) int8, an index into :data:`SOURCES`.
     cell : (v,) int32, the counted cell of a sink, -1 for the others.
-    faces : (v, 6) bool, the faces a RET node retracts through (face 2l: the -e_l side, 2l + 1: +e_l).
+    option_node, option_faces : (o,) and (o, 6) bool, the ways RET nodes retract: every point of the node
+        reaches one of the option's faces (face 2l: the -e_l side, 2l + 1: +e_l) along a path inside the node.
     rank : (v,) int32, 0 for sinks, r >= 1 for resolved RET nodes, -1 for the others.
-    exit : (v,) int8, the face through which a resolved node retracts (-1 elsewhere).
+    exit : (v,) int8, the faces of the option that ranked the node, as bits (bit f: face f; 0 elsewhere).
     seconds : the time taken.
     """
 
@@ -81,7 +84,8 @@ class JointRetraction:
     kind: np.ndarray
     source: np.ndarray
     cell: np.ndarray
-    faces: np.ndarray
+    option_node: np.ndarray
+    option_faces: np.ndarray
     rank: np.ndarray
     exit: np.ndarray
     seconds: float
@@ -130,24 +134,41 @@ def _faces_of_axis(rising: np.ndarray, towards: np.ndarray) -> np.ndarray:
 
 
 class _Nodes:
-    """The node table, filled source by source."""
+    """The node table, filled source by source; each node with its options, (k, 6) face masks."""
 
     def __init__(self):
         self.parts: list[tuple] = []
 
-    def add(self, leaf, signature, kind, source, cell, faces):
+    def add(self, leaf, signature, kind, source, cell, options):
         leaf = np.asarray(leaf, dtype=np.int64)
         m = leaf.size
         kind = np.broadcast_to(np.asarray(kind, dtype=np.int8), (m,))
         cell = np.broadcast_to(np.asarray(cell, dtype=np.int32), (m,))
-        faces = np.broadcast_to(np.asarray(faces, dtype=bool), (m, 6))
+        options = np.asarray(options, dtype=bool)
+        options = np.broadcast_to(options, (m,) + options.shape[-2:])
         self.parts.append((leaf, np.asarray(signature, dtype=np.int64).reshape(m, 3), kind,
-                           np.full(m, source, dtype=np.int8), cell, faces))
+                           np.full(m, source, dtype=np.int8), cell, options))
 
     def table(self):
-        cols = [np.concatenate([p[i] for p in self.parts]) for i in range(6)]
+        """(leaf, signature, kind, source, cell) sorted by leaf, and the options (node, (o, 6) mask) of RET nodes."""
+        cols = [np.concatenate([p[i] for p in self.parts]) for i in range(5)]
         order = np.argsort(cols[0], kind="stable")
-        return [c[order] for c in cols]
+        new = np.empty_like(order)
+        new[order] = np.arange(order.size)
+        opt_node, opt_mask, base = [], [], 0
+        for part in self.parts:
+            options = part[5]
+            m = len(part[0])
+            node, k = np.nonzero(options.any(axis=2) & (part[2] == RET)[:, None])
+            opt_node.append(new[base + node])
+            opt_mask.append(options[node, k])
+            base += m
+        return [c[order] for c in cols], np.concatenate(opt_node), np.concatenate(opt_mask).reshape(-1, 6)
+
+
+def _single_faces(faces: np.ndarray) -> np.ndarray:
+    """(m, 6, 6) options, one per face allowed in ``faces`` (m, 6): each its own face alone."""
+    return np.asarray(faces, dtype=bool)[:, :, None] & np.eye(6, dtype=bool)[None]
 
 
 def _cell_of_piece(piece_cell: np.ndarray, counted: int) -> np.ndarray:
@@ -166,7 +187,7 @@ def _clear_nodes(jp, nodes: _Nodes) -> None:
     c = jp.cell[leaf].astype(np.int64)
     s = sig[c]
     cell = np.where(c < len(jp.cells), c, -1)
-    nodes.add(leaf, s, _kind(cell, s), 0, cell, _ALL_FACES)
+    nodes.add(leaf, s, _kind(cell, s), 0, cell, _EACH_FACE)
 
 
 def _fold_nodes(jp, nodes: _Nodes) -> None:
@@ -180,7 +201,7 @@ def _fold_nodes(jp, nodes: _Nodes) -> None:
         cell = _cell_of_piece(jp.piece_cell[2 * np.flatnonzero(keep) + side], len(jp.cells))
         faces = np.zeros((int(keep.sum()), 6), dtype=bool)
         faces[np.arange(faces.shape[0]), 2 * axis[keep] + side] = True
-        nodes.add(pieces.box[keep], s, _kind(cell, s), 1, cell, faces)
+        nodes.add(pieces.box[keep], s, _kind(cell, s), 1, cell, faces[:, None, :])
 
 
 def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
@@ -194,9 +215,9 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
         for side in sides:
             s = folds.signature[rows, side]
             cell = _cell_of_piece(jp.window_cell[2 * rows + side], counted)
-            faces = (np.ones((rows.size, 6), dtype=bool) if code == CLEAR
-                     else _faces_of_axis(folds.rising[rows], np.int64(1 - 2 * side)))
-            nodes.add(win.leaf[rows], s, _kind(cell, s), 2, cell, faces)
+            options = (_EACH_FACE if code == CLEAR
+                       else _single_faces(_faces_of_axis(folds.rising[rows], np.int64(1 - 2 * side))))
+            nodes.add(win.leaf[rows], s, _kind(cell, s), 2, cell, options)
     # the other modelled rows: pair windows only (besides windows of fixed count), a node per pattern
     pair = pair_windows(models)
     box = models.window_box
@@ -220,9 +241,20 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
                 ok = (towards != 0).all(axis=1) & (towards == towards[:, :1, :]).all(axis=1)
                 faces = _faces_of_axis(np.where(ok, towards[:, 0, :], 0), np.int64(1))
                 s = base[rk] + int(real.sum()) * PAIR
-                nodes.add(win.leaf[rk], s, RET, 3, -1, faces)
+                nodes.add(win.leaf[rk], s, RET, 3, -1, _single_faces(faces))
+    # one cusp window, the others of fixed count: a node for each side (one root, three roots), lifted paths
+    cusp = cusp_windows(models)
+    n_cusp = np.bincount(box, weights=cusp, minlength=n)
+    others = np.bincount(box, weights=~cusp & ~_constant(models), minlength=n) == 0
+    crows = np.flatnonzero(models.ok & ~np.isin(folds.kind, (CLEAR, FOLD)) & (n_cusp == 1) & others)
+    if crows.size:
+        lifted = cusp_retractions(geometry, models, crows)
+        base = base_signature(models)[crows]
+        for side in (0, 1):
+            nodes.add(win.leaf[crows], base + lifted.adds[:, side], RET, 4, -1, lifted.faces[:, side])
     done = np.isin(folds.kind, (CLEAR, FOLD))
     done[rows] = True
+    done[crows] = True
     return np.flatnonzero(~done)
 
 
@@ -247,59 +279,57 @@ def retract_joint_paving(jp, geometry: Geometry) -> JointRetraction:
     if jp.windows is not None:
         covered[jp.windows.leaf[left_rows]] = False  # a window row without nodes: its leaf is LEFT
     left = np.flatnonzero(~covered)
-    nodes.add(left, -np.ones((left.size, 3)), LEFT, 4, -1, np.zeros(6, dtype=bool))
-    leaf, sig, kind, source, cell, faces = nodes.table()
-    rank, exit_ = _ranks(jp.paving, leaf, sig, kind, faces)
-    return JointRetraction(leaf, sig, kind, source, cell, faces, rank, exit_, time.perf_counter() - t0)
+    nodes.add(left, -np.ones((left.size, 3)), LEFT, len(SOURCES) - 1, -1, np.zeros((1, 6), dtype=bool))
+    (leaf, sig, kind, source, cell), opt_node, opt_mask = nodes.table()
+    rank, exit_ = _ranks(jp.paving, leaf, sig, kind, opt_node, opt_mask)
+    return JointRetraction(leaf, sig, kind, source, cell, opt_node, opt_mask, rank, exit_, time.perf_counter() - t0)
 
 
-def _ranks(paving, leaf, sig, kind, faces) -> tuple[np.ndarray, np.ndarray]:
-    """The fixed point of the ranks (module docstring), a worklist over (node, face) entries."""
+def _ranks(paving, leaf, sig, kind, opt_node, opt_mask) -> tuple[np.ndarray, np.ndarray]:
+    """The fixed point of the ranks (module docstring), a worklist over the options: an option of node N is ready
+    when, across every face of its mask, no leaf waits (a LEFT node, or a node of N's signature not yet ranked)."""
     v = leaf.size
     n = len(paving.level)
     pairs, border, _ = directed_face_pairs(paving.level, paving.ijk, paving.depth, periodic=(False, False, False))
     start = np.searchsorted(leaf, np.arange(n + 1))
-    # (node, face) entries of RET nodes, not on the border
-    p_node, p_face = np.nonzero(faces & (kind == RET)[:, None])
-    keep = ~border[leaf[p_node], p_face]
-    p_node, p_face = p_node[keep], p_face[keep]
+    valid = ~(opt_mask & border[leaf[opt_node]]).any(axis=1)  # an option with a face on the border proves nothing
+    opt_node, opt_mask = opt_node[valid], opt_mask[valid]
+    option, face = np.nonzero(opt_mask)
     # leaf pairs across each face, looked up by (leaf, face)
     key = pairs[0] * 6 + pairs[2]
     order = np.argsort(key, kind="stable")
     key, across = key[order], pairs[1][order]
-    e_lo = np.searchsorted(key, leaf[p_node] * 6 + p_face)
-    e_hi = np.searchsorted(key, leaf[p_node] * 6 + p_face, side="right")
-    entry = np.repeat(np.arange(p_node.size), e_hi - e_lo)
+    want = leaf[opt_node[option]] * 6 + face
+    e_lo, e_hi = np.searchsorted(key, want), np.searchsorted(key, want, side="right")
+    entry = np.repeat(option, e_hi - e_lo)
     nb = across[np.repeat(e_lo, e_hi - e_lo) + _ramp(e_hi - e_lo)]
-    # the nodes of each neighbour leaf that the entry waits for: same signature, or of unknown signature
+    # the nodes of each neighbour leaf the option waits for: same signature, or of unknown signature
     q = np.repeat(start[nb], start[nb + 1] - start[nb]) + _ramp(start[nb + 1] - start[nb])
     entry = np.repeat(entry, start[nb + 1] - start[nb])
-    wait = (sig[q, 0] < 0) | (sig[q] == sig[p_node[entry]]).all(axis=1)
-    wait &= kind[q] != SINK
+    wait = ((sig[q, 0] < 0) | (sig[q] == sig[opt_node[entry]]).all(axis=1)) & (kind[q] != SINK)
     entry, q = entry[wait], q[wait]
-    pending = np.bincount(entry, minlength=p_node.size)
+    pending = np.bincount(entry, minlength=opt_node.size)
     by_q = np.argsort(q, kind="stable")
     q_sorted, entry_by_q = q[by_q], entry[by_q]
     rank = np.where(kind == SINK, 0, -1).astype(np.int32)
-    exit_ = np.full(v, -1, dtype=np.int8)
+    exit_ = np.zeros(v, dtype=np.int8)
+    bits = (opt_mask * (1 << np.arange(6))).sum(axis=1).astype(np.int8)
     ready = np.flatnonzero(pending == 0)
     r = 0
     while ready.size:
         r += 1
-        fresh = p_node[ready]
-        fresh_new = rank[fresh] < 0
-        ready, fresh = ready[fresh_new], fresh[fresh_new]
-        fresh, first = np.unique(fresh, return_index=True)
+        ready = ready[rank[opt_node[ready]] < 0]
+        fresh, first = np.unique(opt_node[ready], return_index=True)
         if not fresh.size:
             break
         rank[fresh] = r
-        exit_[fresh] = p_face[ready[first]]
+        exit_[fresh] = bits[ready[first]]
         lo = np.searchsorted(q_sorted, fresh)
         hi = np.searchsorted(q_sorted, fresh, side="right")
         hit = entry_by_q[np.repeat(lo, hi - lo) + _ramp(hi - lo)]
         np.subtract.at(pending, hit, 1)
         hit = np.unique(hit)
-        ready = hit[(pending[hit] == 0) & (rank[p_node[hit]] < 0)]
+        ready = hit[(pending[hit] == 0) & (rank[opt_node[hit]] < 0)]
     return rank, exit_
 
 

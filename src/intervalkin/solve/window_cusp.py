@@ -1,0 +1,215 @@
+"""Cusp windows retracted along the lifted roots: how a box near a cusp edge of g(S) moves off it.
+
+A window model (:mod:`intervalkin.solve.window_model`) of a joint box R has a *cusp window*
+[w_a, w_b] when f''' has one strict sign there, the end signs of f differ (e0 = sign f(w_a)) and
+they, and the sign of D, hold over the whole box: f(.; r) has one or three roots in it, for every r
+in R^2 (r = rho^2).  With three roots phi_1 < phi_2 < phi_3, the signs of f' at them are -e0, e0,
+-e0: the MIDDLE root is the only one with e0 f' > 0.  With one root, it has -e0 f' > 0 and
+g(t) = f(t) / (t - phi) (continued by f'(phi) at t = phi) keeps the sign -e0 over the whole window.
+
+No straight line moves the points of a box near a cusp edge off it while keeping their count (the
+wedge of three roots narrows like |x|^(3/2) towards the edge).  A curved path does: keep phi fixed at
+one root, move r along d u and let it follow along v so that f(phi; r) = 0 stays true
+(r' = d u + H' v, H' = -d f_u / f_v).  Along it
+
+    d/dt f_phi(phi; r) = d J / f_v,    J = f_phi,u f_v - f_phi,v f_u,
+    d/dt g(t; r)       in d K / f_v for every t where f may vanish,
+
+K the interval of J with the phi-derivatives enclosed between the root and t.  When J (resp. K) and
+f_v have proved signs (sJ, sv):
+
+* the middle root keeps e0 f_phi > 0 for d = e0 sJ sv: a box point with three roots in the window
+  moves, keeping them, until r reaches a face of R;
+* with d = -e0 sK sv, -e0 g stays > 0 where f may vanish: a point with one root keeps one root.
+
+r_i moves with the sign of d (u_i f_v - v_i f_u) / f_v: one face of axis i where that is proved, either
+otherwise.  The pairs (u, v) tried: the six axis pairs (u = e_a, v = e_l) and one pair per box read at its
+centre (proofs/lemma-joint-retraction.md, "Cusp windows: lifted paths").  Certified: every factor is an
+outward-rounded ball enclosure (:meth:`intervalkin.solve.simple_roots.ReducedBoxes.r_slope`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from intervalkin.core.geometry import Geometry
+from intervalkin.core.interval import Interval, sign_label
+from intervalkin.solve.simple_roots import ReducedBoxes
+from intervalkin.solve.window_model import DET_SIGN, WindowModels
+
+__all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_retractions", "cusp_windows"]
+
+#: Halvings of a cusp window's pieces before the slopes are read.
+HALVINGS = 0
+#: The (l, a) pairs tried: r_l follows the root, r_a is driven.
+AXIS_PAIRS = tuple((l, a) for l in range(3) for a in range(3) if a != l)
+
+
+@dataclass(frozen=True, eq=False)
+class CuspRetractions:
+    """For boxes with one cusp window: the signature the window adds, and the faces each side retracts through.
+
+    rows : (m,) the boxes (rows of the models); window : (m,) their cusp window.
+    adds : (m, 2, 3) int64, (count, n_wa1, n_wa2) of the window's roots: one root (0), three roots (1).
+    faces : (m, 2, k, 6) bool, for each side (one root, three roots) and each of k = len(AXIS_PAIRS) + 1 ways
+        (the axis pairs, then the box's own pair of directions), the faces the side's points may reach along the
+        lifted path (all False where the way proves nothing; every face of a way must be resolved).
+    drive : (m, 2, k) int8, d: r moves along d u while the followed root is held by moving along v.
+    drive_u, follow_v : (m, k, 3) the vectors u and v of each way (in r = rho^2).
+    """
+
+    rows: np.ndarray
+    window: np.ndarray
+    adds: np.ndarray
+    faces: np.ndarray
+    drive: np.ndarray
+    drive_u: np.ndarray
+    follow_v: np.ndarray
+
+
+def cusp_windows(models: WindowModels) -> np.ndarray:
+    """(w,) bool: the windows of degree 3 whose end signs differ, with end signs and sign of D proved over the box."""
+    ends = models.end_signs.astype(np.int64)
+    firm = (ends != 0).all(axis=1) & (models.d_sign != 0)
+    return firm & (models.degree == 3) & (ends[:, 0] != ends[:, 1])
+
+
+def cusp_retractions(geometry: Geometry, models: WindowModels, rows: np.ndarray,
+                     halvings: int = HALVINGS) -> CuspRetractions:
+    """The lifted retractions of boxes ``rows``, each with exactly one cusp window (module docstring).  The
+    window's pieces are halved ``halvings`` times; the slopes at the followed root are read on the pieces
+    where it can be (f may vanish, f' may have its sign)."""
+    rows = np.asarray(rows, dtype=np.int64)
+    m = rows.size
+    cusp = cusp_windows(models) & np.isin(models.window_box, rows)
+    window = np.flatnonzero(cusp)
+    if window.size != m or not np.array_equal(models.window_box[window], rows):
+        raise ValueError("cusp_retractions: each row needs exactly one cusp window")
+    e0 = models.end_signs[window, 0].astype(np.int64)
+    d = models.d_sign[window].astype(np.int64)
+    # the det A sign of a root is DET_SIGN sign(D) sign(f'); outer roots have f' of sign -e0, the middle one e0
+    outer_wa1 = (DET_SIGN * d * -e0) > 0
+    adds = np.zeros((m, 2, 3), dtype=np.int64)
+    adds[:, 0] = np.stack([np.ones(m, dtype=np.int64), outer_wa1, ~outer_wa1], axis=1)
+    adds[:, 1] = np.stack([np.full(m, 3), 2 * outer_wa1 + ~outer_wa1, 2 * ~outer_wa1 + outer_wa1], axis=1)
+    k = len(AXIS_PAIRS) + 1
+    faces = np.zeros((m, 2, k, 6), dtype=bool)
+    drive = np.zeros((m, 2, k), dtype=np.int8)
+    drive_u, follow_v = np.zeros((m, k, 3)), np.zeros((m, k, 3))
+    if not m:
+        return CuspRetractions(rows, window, adds, faces, drive, drive_u, follow_v)
+    on = np.isin(models.piece_window, window)
+    pw, lo, hi = models.piece_window[on], models.piece_lo[on], models.piece_hi[on]
+    pos = np.flatnonzero(on)  # a window's pieces are stored in circle order: their index is their position
+    for _ in range(halvings):
+        mid = np.minimum(np.maximum(0.5 * lo + 0.5 * hi, lo), hi)
+        pw, lo, hi, pos = np.r_[pw, pw], np.r_[lo, mid], np.r_[mid, hi], np.r_[pos, pos]
+    slot = np.full(len(models.degree), -1, dtype=np.int64)
+    slot[window] = np.arange(m)
+    owner = slot[pw]
+    data = ReducedBoxes(geometry, models.boxes[rows])
+    f = sign_label(data.enclosure(owner, lo, hi, 0))
+    f1 = sign_label(data.enclosure(owner, lo, hi, 1)) * e0[owner]
+    f_r = [data.r_slope(owner, lo, hi, axis) for axis in range(3)]
+    f_phi_r = [data.r_slope(owner, lo, hi, axis, deriv=1) for axis in range(3)]
+    # where the followed root can be: the middle root (e0 f' > 0) for three roots, the single root (-e0 f' > 0)
+    at_root = {1: (f == 0) & (f1 >= 0), 0: (f == 0) & (f1 <= 0)}
+    # new roots can only appear where f may vanish; g(t) involves f' between the root and t: the span of those pieces
+    first = np.full(m, np.iinfo(np.int64).max)
+    last = np.full(m, -1)
+    np.minimum.at(first, owner[f == 0], pos[f == 0])
+    np.maximum.at(last, owner[f == 0], pos[f == 0])
+    between = (pos >= first[owner]) & (pos <= last[owner])
+    sets = {"root": at_root, "between": between, "owner": owner, "m": m, "e0": e0}
+    eye = np.eye(3)
+    drive_u[:, :len(AXIS_PAIRS)] = eye[[a for _, a in AXIS_PAIRS]][None]
+    follow_v[:, :len(AXIS_PAIRS)] = eye[[l for l, _ in AXIS_PAIRS]][None]
+    # one more pair per box: follow the mean direction of grad_r f over the window, drive along the normal
+    # of the fold set {f = f_phi = 0} in it, both read at the box centre (floats: any fixed vectors will do)
+    drive_u[:, -1], follow_v[:, -1] = _centre_directions(geometry, models.boxes[rows], owner, lo, hi, f == 0, m)
+    for p in range(len(AXIS_PAIRS) + 1):
+        faces[:, :, p], drive[:, :, p] = _lifted_faces(f_r, f_phi_r, drive_u[:, p], follow_v[:, p], sets)
+    for side in (0, 1):  # a side proved empty (no piece can hold its root) retracts through any single face
+        empty = np.bincount(owner, weights=at_root[side], minlength=m) == 0
+        faces[empty, side] = np.eye(len(AXIS_PAIRS) + 1, 6, dtype=bool)[None]
+        drive[empty, side] = 0
+    return CuspRetractions(rows, window, adds, faces, drive, drive_u, follow_v)
+
+
+def _hull(value: Interval, owner: np.ndarray, keep: np.ndarray, m: int) -> Interval:
+    """The hull per window of the pieces ``keep`` of ``value`` (empty windows: [inf, -inf])."""
+    lo = np.full(m, np.inf)
+    hi = np.full(m, -np.inf)
+    np.minimum.at(lo, owner[keep], value.lo[keep])
+    np.maximum.at(hi, owner[keep], value.hi[keep])
+    return Interval(lo, hi)
+
+
+def _sign_over(value: Interval, owner: np.ndarray, keep: np.ndarray, m: int) -> np.ndarray:
+    """(m,) the sign of ``value`` proved on every piece ``keep`` of each window (0: not proved, or no piece)."""
+    h = _hull(value, owner, keep, m)
+    return np.where(h.lo > 0, 1, np.where(h.hi < 0, -1, 0)).astype(np.int64)
+
+
+def _combine(parts: list[Interval], w: np.ndarray) -> Interval:
+    """sum_i w_i parts_i for per-piece float weights w (k, 3), outward rounded."""
+    out = parts[0] * w[:, 0]
+    for i in (1, 2):
+        out = out + parts[i] * w[:, i]
+    return out
+
+
+def _lifted_faces(f_r: list[Interval], f_phi_r: list[Interval], u: np.ndarray, v: np.ndarray,
+                  sets: dict) -> tuple[np.ndarray, np.ndarray]:
+    """((m, 2, 6) bool, (m, 2) int8): for each side (one root, three roots), the faces its lifted path may leave the
+    box through when r moves along d u, the followed root held by moving along v, and d (0 where nothing is
+    proved: no face)."""
+    owner, m, e0, root = sets["owner"], sets["m"], sets["e0"], sets["root"]
+    up, vp = u[owner], v[owner]
+    fu, fv = _combine(f_r, up), _combine(f_r, vp)
+    gu, gv = _combine(f_phi_r, up), _combine(f_phi_r, vp)
+    out = np.zeros((m, 2, 6), dtype=bool)
+    drives = np.zeros((m, 2), dtype=np.int8)
+    for side in (0, 1):
+        at = root[side]
+        sv = _sign_over(fv, owner, at, m)
+        if side == 1:  # d/dt f_phi at the middle root: J at one point of the window
+            sk = _sign_over(gu * fv - gv * fu, owner, at, m)
+        else:  # d/dt g(t) where f may vanish: f_phi,r between the root and t, the r-slopes at the root
+            between = sets["between"]
+            k = _hull(gu, owner, between, m) * _hull(fv, owner, at, m) - _hull(gv, owner, between, m) * _hull(fu, owner, at, m)
+            sk = np.where(k.lo > 0, 1, np.where(k.hi < 0, -1, 0))
+        drive = e0 * sk * sv * (1 if side == 1 else -1)  # the sign d that keeps the side (0: none proved)
+        moving = np.zeros(m, dtype=bool)
+        for i in range(3):  # dr_i/dt = d (u_i f_v - v_i f_u) / f_v
+            still = (u[:, i] == 0) & (v[:, i] == 0)
+            vel = drive * sv * _sign_over(fv * up[:, i] - fu * vp[:, i], owner, at, m)
+            moving |= vel != 0
+            out[:, side, 2 * i] = (drive != 0) & ~still & (vel <= 0)
+            out[:, side, 2 * i + 1] = (drive != 0) & ~still & (vel >= 0)
+        out[~moving, side] = False  # no coordinate proved monotone: the path might never leave the box
+        drives[:, side] = np.where(moving, drive, 0)
+    return out, drives
+
+
+def _centre_directions(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                       keep: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """(u, v) (m, 3) per box: v the mean unit grad_r f, u the mean unit w = f_v grad_r f_phi - f_phi,v grad_r f,
+    over the pieces ``keep`` at the box centre (float guesses; the proofs enclose whatever they are)."""
+    centre = boxes.mean(axis=2)
+    data = ReducedBoxes(geometry, np.stack([centre, centre], axis=-1))
+    at = np.flatnonzero(keep)
+    mid = 0.5 * lo[at] + 0.5 * hi[at]
+    grad = np.stack([data.r_slope(owner[at], mid, mid, i).mid() for i in range(3)], axis=1)
+    grad_phi = np.stack([data.r_slope(owner[at], mid, mid, i, deriv=1).mid() for i in range(3)], axis=1)
+    v = np.zeros((m, 3))
+    np.add.at(v, owner[at], grad / np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), 1e-300))
+    v /= np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-300)
+    vp = v[owner[at]]
+    w = (grad * vp).sum(axis=1, keepdims=True) * grad_phi - (grad_phi * vp).sum(axis=1, keepdims=True) * grad
+    u = np.zeros((m, 3))
+    np.add.at(u, owner[at], w / np.maximum(np.linalg.norm(w, axis=1, keepdims=True), 1e-300))
+    u /= np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-300)
+    return u, v
