@@ -108,7 +108,9 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
                 f"kind, {places.get('volume_window_model', 0.0):.2f} with a window model (a certified count at each "
                 "point, pieces not proved connected). "
                 "A cell could hide in a place, or two cells meet through one, so no upper bound is proved. "
-                + _why_line(places.get("by_reason") or {}) + "The largest:\n",
+                + _why_line(places.get("by_reason") or {})
+                + _retraction_line(((summary.get("basic_regions") or {}).get("undecided") or {}).get("retraction"))
+                + "The largest:\n",
                 "| volume | leaves | without a model | from (rho_1, rho_2, rho_3) | to | on a face | why (leaves) |",
                 "|---|---|---|---|---|---|---|"]
         for q in places["largest"][:10]:
@@ -124,6 +126,24 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
 _WHY = {"no_model": "no model", "cusp_window": "cusp window", "window_at_points": "window signs at points only",
         "pair_windows": "several pair windows", "slope_not_certified": "one pair window (slope not certified)",
         "fold_piece_count": "fold piece of unknown count", "other": "other"}
+
+
+#: Short names of the kinds of nodes (space.joint_retraction.SOURCES).
+_NODES = {"clear": "clear leaves", "fold_piece": "fold pieces", "window_piece": "window pieces",
+          "pair_pattern": "pair-window patterns", "cusp_side": "cusp sides", "no_piece_model": "leaves without pieces"}
+
+
+def _retraction_line(block: dict | None) -> str:
+    """One sentence: how far the open layer retracts into the cells (the local step of an upper bound)."""
+    if not block:
+        return ""
+    left = [f"{_NODES.get(k, k)} {v['unresolved']}" for k, v in block["by_source"].items() if v["unresolved"]]
+    head = (f"Retraction towards the cells (proofs/lemma-joint-retraction.md): {block['resolved']} of "
+            f"{block['nodes'] - block['sinks']} nodes off the cells are ranked")
+    if block["closed"]:
+        return head + ": every point off g(S) is joined to a cell of its signature. "
+    return (head + f"; {block['leaves_unresolved']} leaves (volume {block['volume_unresolved']:.2f}) still hold a node "
+            "that is not, so no upper bound: " + ", ".join(left) + ". ")
 
 
 def _why_line(by_reason: dict) -> str:
