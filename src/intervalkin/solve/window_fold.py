@@ -43,13 +43,13 @@ import numpy as np
 
 from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.interval import sign_label
+from intervalkin.core.interval import Interval, sign_label
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_count import window_signature
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced", "fold_piece",
-           "extreme_corners", "base_signature", "pair_windows", "pair_slopes"]
+           "extreme_corners", "base_signature", "pair_windows", "pair_slopes", "pair_direction_signs"]
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
@@ -211,13 +211,10 @@ def why_not_pieced(models: WindowModels, folds: WindowFolds) -> np.ndarray:
     return out
 
 
-def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: int, pw: np.ndarray,
-            lo: np.ndarray, hi: np.ndarray, halvings: int) -> np.ndarray:
-    """(w, 3) int8 per window: the certified sign of s d f / d r_l on its critical pieces (0: not certified).
-
-    A window with no critical piece left has u > 0 on all of R (no root): every direction is
-    valid for it, and +1 is returned.
-    """
+def _critical(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, pw: np.ndarray, lo: np.ndarray,
+              hi: np.ndarray, halvings: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The critical pieces (pw, lo, hi) of pair windows: where neither s f > 0 nor df/dphi != 0 is proved over
+    R^2 x piece (the window's minimum of s f can only sit there), halved ``halvings`` times."""
     for round_ in range(halvings + 1):
         owner = owner_of_window[pw]
         crit = sign_label(data.enclosure(owner, lo, hi, 1)) == 0
@@ -227,6 +224,17 @@ def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: i
         if round_ < halvings:
             mid = np.minimum(np.maximum(0.5 * lo + 0.5 * hi, lo), hi)
             pw, lo, hi = np.r_[pw, pw], np.r_[lo, mid], np.r_[mid, hi]
+    return pw, lo, hi
+
+
+def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: int, pw: np.ndarray,
+            lo: np.ndarray, hi: np.ndarray, halvings: int) -> np.ndarray:
+    """(w, 3) int8 per window: the certified sign of s d f / d r_l on its critical pieces (0: not certified).
+
+    A window with no critical piece left has u > 0 on all of R (no root): every direction is
+    valid for it, and +1 is returned.
+    """
+    pw, lo, hi = _critical(data, owner_of_window, s, pw, lo, hi, halvings)
     out = np.ones((w, 3), dtype=np.int8)
     owner = owner_of_window[pw]
     for axis in range(3):
@@ -237,6 +245,42 @@ def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: i
         np.maximum.at(high, pw, sg)
         out[:, axis] = np.where(low == 2, 1, np.where((low == high) & (low != 0), low, 0))
     return out
+
+
+def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndarray, directions: np.ndarray,
+                         halvings: int = CRITICAL_HALVINGS) -> tuple[np.ndarray, np.ndarray]:
+    """For the pair windows of boxes ``rows`` and each direction e (c, 3) in rho: ((w, c) int8, the certified
+    sign of s D_e f = s sum_l e_l 2 rho_l df/dr_l on the window's critical pieces over R, that is the direction
+    in which u = min s f moves along e (0: not certified); (w,) bool, windows with no critical piece (u > 0 on
+    the whole box)).  Other windows: 0 and False."""
+    w = len(models.degree)
+    rows = np.asarray(rows, dtype=np.int64)
+    directions = np.asarray(directions, dtype=np.float64)
+    out = np.zeros((w, len(directions)), dtype=np.int8)
+    even = pair_windows(models) & np.isin(models.window_box, rows)
+    if not even.any():
+        return out, np.zeros(w, dtype=bool)
+    on = np.isin(models.piece_window, np.flatnonzero(even))
+    row = np.full(len(models.ok), -1, dtype=np.int64)
+    row[rows] = np.arange(rows.size)
+    data = ReducedBoxes(geometry, models.boxes[rows])
+    s = models.end_signs[:, 0].astype(np.int64)
+    pw, lo, hi = _critical(data, row[models.window_box], s, models.piece_window[on], models.piece_lo[on],
+                           models.piece_hi[on], halvings)
+    owner = row[models.window_box][pw]
+    box = models.boxes[rows][owner]
+    grad = [data.r_slope(owner, lo, hi, axis) * Interval(2.0 * box[:, axis, 0], 2.0 * box[:, axis, 1])
+            for axis in range(3)]
+    free = even & (np.bincount(pw, minlength=w) == 0)
+    for c, e in enumerate(directions):
+        value = grad[0] * e[0] + grad[1] * e[1] + grad[2] * e[2]
+        sg = sign_label(value).astype(np.int64) * s[pw]
+        low = np.full(w, 2, dtype=np.int64)
+        high = np.full(w, -2, dtype=np.int64)
+        np.minimum.at(low, pw, sg)
+        np.maximum.at(high, pw, sg)
+        out[:, c] = np.where(even & (low == high) & (np.abs(low) == 1), low, 0)
+    return out, free
 
 
 def _edge_slopes(geometry: Geometry, models: WindowModels, rows: np.ndarray, rising: np.ndarray, window: np.ndarray,

@@ -17,10 +17,11 @@ of the node in it up to the face:
 
 * a node of a clear leaf: through every face (the signature is the same on the whole box);
 * the fold piece below: through the -e_k face; the piece above: through the +e_k face;
-* a pattern node: through the d e_l face when, for each pair window i, the slope c_il (the certified
-  sign of s df/dr_l over the window's critical pieces, :func:`~intervalkin.solve.window_fold.pair_slopes`)
-  is not zero and d = c_il where window i is empty (u_i = min s f > 0 grows), d = -c_il where it holds two
-  roots (u_i < 0 falls); the other roots are the same on the whole box.
+* a pattern node: along a direction e of :data:`DIRECTIONS`, through the faces on the sides of e's nonzero
+  entries, when for each pair window i the sign of s D_e f over the window's critical pieces
+  (:func:`~intervalkin.solve.window_fold.pair_direction_signs`) is +1 where the window is empty (u_i = min s f
+  > 0 does not fall) and -1 where it holds two roots (u_i < 0 does not rise); the other roots are the same
+  on the whole box.
 
 RANKS (a fixed point): a node is resolved at rank r >= 1 when, for some face f it retracts through that is not
 on the border of the joint box, every leaf across f is modelled (no LEFT node of unknown signature) and
@@ -39,6 +40,8 @@ bound is claimed.
 
 from __future__ import annotations
 
+import itertools
+import math
 import time
 from dataclasses import dataclass
 
@@ -47,7 +50,7 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.paving.adjacency import directed_face_pairs
 from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
-from intervalkin.solve.window_fold import CLEAR, FOLD, PAIR, base_signature, pair_slopes, pair_windows
+from intervalkin.solve.window_fold import CLEAR, FOLD, PAIR, base_signature, pair_direction_signs, pair_windows
 
 __all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_PAIR_WINDOWS", "JointRetraction", "retract_joint_paving"]
 
@@ -60,6 +63,13 @@ SOURCES = ("clear", "fold_piece", "window_piece", "pair_pattern", "cusp_side", "
 #: Window-modelled leaves with more pair windows than this are LEFT (2**k patterns each).
 MAX_PAIR_WINDOWS = 3
 _EACH_FACE = np.eye(6, dtype=bool)
+#: Directions e (in rho) tried for the patterns of pair windows: integer vectors with entries in -2..2, not
+#: multiples of one another, fewest nonzero entries first (a straight retraction along e leaves through one face
+#: per nonzero entry, all of which must be resolved).
+DIRECTIONS = np.array(sorted((e for e in itertools.product(range(-2, 3), repeat=3)
+                              if any(e) and math.gcd(*e) == 1), key=lambda e: (sum(map(bool, e)), e)), dtype=np.int64)
+#: Directions kept per node (the first that hold, fewest faces first).
+MAX_OPTIONS = 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,7 +85,9 @@ class JointRetraction:
     option_node, option_faces : (o,) and (o, 6) bool, the ways RET nodes retract: every point of the node
         reaches one of the option's faces (face 2l: the -e_l side, 2l + 1: +e_l) along a path inside the node.
     rank : (v,) int32, 0 for sinks, r >= 1 for resolved RET nodes, -1 for the others.
-    exit : (v,) int8, the faces of the option that ranked the node, as bits (bit f: face f; 0 elsewhere).
+    option_direction : (o, 3) float, the direction e in rho of a straight option (the segment from each point
+        along e), zeros for a lifted path (:mod:`intervalkin.solve.window_cusp`).
+    exit : (v,) int64, the option that ranked the node (an index into the option arrays), -1 elsewhere.
     seconds : the time taken.
     """
 
@@ -86,6 +98,7 @@ class JointRetraction:
     cell: np.ndarray
     option_node: np.ndarray
     option_faces: np.ndarray
+    option_direction: np.ndarray
     rank: np.ndarray
     exit: np.ndarray
     seconds: float
@@ -139,15 +152,20 @@ class _Nodes:
     def __init__(self):
         self.parts: list[tuple] = []
 
-    def add(self, leaf, signature, kind, source, cell, options):
+    def add(self, leaf, signature, kind, source, cell, options, directions=None):
         leaf = np.asarray(leaf, dtype=np.int64)
         m = leaf.size
         kind = np.broadcast_to(np.asarray(kind, dtype=np.int8), (m,))
         cell = np.broadcast_to(np.asarray(cell, dtype=np.int32), (m,))
         options = np.asarray(options, dtype=bool)
         options = np.broadcast_to(options, (m,) + options.shape[-2:])
+        if directions is None:  # one face: the straight segment along its outward normal; several: a lifted path
+            one = options.sum(axis=2) == 1
+            face = np.argmax(options, axis=2)
+            directions = np.where(one[..., None], np.eye(3)[face // 2] * (2 * (face % 2) - 1)[..., None], 0.0)
+        directions = np.broadcast_to(np.asarray(directions, dtype=np.float64), options.shape[:2] + (3,))
         self.parts.append((leaf, np.asarray(signature, dtype=np.int64).reshape(m, 3), kind,
-                           np.full(m, source, dtype=np.int8), cell, options))
+                           np.full(m, source, dtype=np.int8), cell, options, directions))
 
     def table(self):
         """(leaf, signature, kind, source, cell) sorted by leaf, and the options (node, (o, 6) mask) of RET nodes."""
@@ -155,15 +173,34 @@ class _Nodes:
         order = np.argsort(cols[0], kind="stable")
         new = np.empty_like(order)
         new[order] = np.arange(order.size)
-        opt_node, opt_mask, base = [], [], 0
+        opt_node, opt_mask, opt_dir, base = [], [], [], 0
         for part in self.parts:
             options = part[5]
             m = len(part[0])
             node, k = np.nonzero(options.any(axis=2) & (part[2] == RET)[:, None])
             opt_node.append(new[base + node])
             opt_mask.append(options[node, k])
+            opt_dir.append(part[6][node, k])
             base += m
-        return [c[order] for c in cols], np.concatenate(opt_node), np.concatenate(opt_mask).reshape(-1, 6)
+        return ([c[order] for c in cols], np.concatenate(opt_node), np.concatenate(opt_mask).reshape(-1, 6),
+                np.concatenate(opt_dir).reshape(-1, 3))
+
+
+def _direction_options(keeps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(m, MAX_OPTIONS, 6) options and (m, MAX_OPTIONS, 3) their directions from (m, c) bool, the directions of
+    :data:`DIRECTIONS` that keep each node: the first MAX_OPTIONS, each with a face per nonzero entry, on its side."""
+    faces = np.zeros((len(DIRECTIONS), 6), dtype=bool)
+    for ax in range(3):
+        faces[:, 2 * ax] = DIRECTIONS[:, ax] < 0
+        faces[:, 2 * ax + 1] = DIRECTIONS[:, ax] > 0
+    rank = np.where(keeps, np.arange(keeps.shape[1])[None, :], keeps.shape[1])
+    first = np.sort(rank, axis=1)[:, :MAX_OPTIONS]
+    out = np.zeros((len(keeps), first.shape[1], 6), dtype=bool)
+    direction = np.zeros((len(keeps), first.shape[1], 3))
+    held = first < keeps.shape[1]
+    out[held] = faces[first[held]]
+    direction[held] = DIRECTIONS[first[held]]
+    return out, direction
 
 
 def _single_faces(faces: np.ndarray) -> np.ndarray:
@@ -227,21 +264,18 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
     rows = np.flatnonzero(models.ok & ~np.isin(folds.kind, (CLEAR, FOLD)) & only_pairs
                           & (n_pair >= 1) & (n_pair <= MAX_PAIR_WINDOWS))
     if rows.size:
-        slope = pair_slopes(geometry, models, rows)
+        signs, free = pair_direction_signs(geometry, models, rows, DIRECTIONS)
         base = base_signature(models)
         for k in range(1, MAX_PAIR_WINDOWS + 1):
             rk = rows[n_pair[rows] == k]
             if not rk.size:
                 continue
             wins = np.flatnonzero(pair & np.isin(box, rk)).reshape(rk.size, k)  # windows are sorted by box
-            c = slope[wins].astype(np.int64)  # (m, k, 3)
             for pattern in range(1 << k):
                 real = np.array([(pattern >> i) & 1 for i in range(k)], dtype=np.int64)
-                towards = (1 - 2 * real)[None, :, None] * c  # the direction each window allows, per axis
-                ok = (towards != 0).all(axis=1) & (towards == towards[:, :1, :]).all(axis=1)
-                faces = _faces_of_axis(np.where(ok, towards[:, 0, :], 0), np.int64(1))
-                s = base[rk] + int(real.sum()) * PAIR
-                nodes.add(win.leaf[rk], s, RET, 3, -1, _single_faces(faces))
+                # u_i must not fall where window i is empty, not rise where it holds its two roots
+                keeps = ((signs[wins] * (1 - 2 * real)[None, :, None] == 1) | free[wins][:, :, None]).all(axis=1)
+                nodes.add(win.leaf[rk], base[rk] + int(real.sum()) * PAIR, RET, 3, -1, *_direction_options(keeps))
     # one cusp window, the others of fixed count: a node for each side (one root, three roots), lifted paths
     cusp = cusp_windows(models)
     n_cusp = np.bincount(box, weights=cusp, minlength=n)
@@ -251,7 +285,8 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
         lifted = cusp_retractions(geometry, models, crows)
         base = base_signature(models)[crows]
         for side in (0, 1):
-            nodes.add(win.leaf[crows], base + lifted.adds[:, side], RET, 4, -1, lifted.faces[:, side])
+            nodes.add(win.leaf[crows], base + lifted.adds[:, side], RET, 4, -1, lifted.faces[:, side],
+                      np.zeros(lifted.faces.shape[2:3] + (3,)))  # lifted paths, not segments
     done = np.isin(folds.kind, (CLEAR, FOLD))
     done[rows] = True
     done[crows] = True
@@ -280,20 +315,22 @@ def retract_joint_paving(jp, geometry: Geometry) -> JointRetraction:
         covered[jp.windows.leaf[left_rows]] = False  # a window row without nodes: its leaf is LEFT
     left = np.flatnonzero(~covered)
     nodes.add(left, -np.ones((left.size, 3)), LEFT, len(SOURCES) - 1, -1, np.zeros((1, 6), dtype=bool))
-    (leaf, sig, kind, source, cell), opt_node, opt_mask = nodes.table()
+    (leaf, sig, kind, source, cell), opt_node, opt_mask, opt_dir = nodes.table()
     rank, exit_ = _ranks(jp.paving, leaf, sig, kind, opt_node, opt_mask)
-    return JointRetraction(leaf, sig, kind, source, cell, opt_node, opt_mask, rank, exit_, time.perf_counter() - t0)
+    return JointRetraction(leaf, sig, kind, source, cell, opt_node, opt_mask, opt_dir, rank, exit_,
+                           time.perf_counter() - t0)
 
 
 def _ranks(paving, leaf, sig, kind, opt_node, opt_mask) -> tuple[np.ndarray, np.ndarray]:
     """The fixed point of the ranks (module docstring), a worklist over the options: an option of node N is ready
-    when, across every face of its mask, no leaf waits (a LEFT node, or a node of N's signature not yet ranked)."""
+    when, across every face of its mask, no leaf waits (a LEFT node, or a node of N's signature not yet ranked).
+    Returns (rank, the option that ranked each node or -1)."""
     v = leaf.size
     n = len(paving.level)
     pairs, border, _ = directed_face_pairs(paving.level, paving.ijk, paving.depth, periodic=(False, False, False))
     start = np.searchsorted(leaf, np.arange(n + 1))
-    valid = ~(opt_mask & border[leaf[opt_node]]).any(axis=1)  # an option with a face on the border proves nothing
-    opt_node, opt_mask = opt_node[valid], opt_mask[valid]
+    index = np.flatnonzero(~(opt_mask & border[leaf[opt_node]]).any(axis=1))  # a face on the border: nothing proved
+    opt_node, opt_mask = opt_node[index], opt_mask[index]
     option, face = np.nonzero(opt_mask)
     # leaf pairs across each face, looked up by (leaf, face)
     key = pairs[0] * 6 + pairs[2]
@@ -312,8 +349,7 @@ def _ranks(paving, leaf, sig, kind, opt_node, opt_mask) -> tuple[np.ndarray, np.
     by_q = np.argsort(q, kind="stable")
     q_sorted, entry_by_q = q[by_q], entry[by_q]
     rank = np.where(kind == SINK, 0, -1).astype(np.int32)
-    exit_ = np.zeros(v, dtype=np.int8)
-    bits = (opt_mask * (1 << np.arange(6))).sum(axis=1).astype(np.int8)
+    exit_ = np.full(v, -1, dtype=np.int64)
     ready = np.flatnonzero(pending == 0)
     r = 0
     while ready.size:
@@ -323,7 +359,7 @@ def _ranks(paving, leaf, sig, kind, opt_node, opt_mask) -> tuple[np.ndarray, np.
         if not fresh.size:
             break
         rank[fresh] = r
-        exit_[fresh] = bits[ready[first]]
+        exit_[fresh] = index[ready[first]]
         lo = np.searchsorted(q_sorted, fresh)
         hi = np.searchsorted(q_sorted, fresh, side="right")
         hit = entry_by_q[np.repeat(lo, hi - lo) + _ramp(hi - lo)]
