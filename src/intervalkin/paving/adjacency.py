@@ -299,13 +299,14 @@ def connected_components(n: int, edges: np.ndarray, mask: np.ndarray) -> list[fr
     return [frozenset(c) for c in nx.connected_components(g)]
 
 
-def directed_face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int, periodic=(False, False, True)
-                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def directed_face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int, periodic=(False, False, True),
+                        source: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Directed face adjacency of a tiling: (pairs (3, m): box, neighbour, face), on_border (n, 6), edges.
 
     Row (a, b, f): b lies across face f of a (face 2k: the -axis-k side, 2k + 1: the + side).
     ``on_border[a, f]``: face f of a lies on the border of the domain along an axis that does not
-    wrap (no neighbour there).  ``edges`` is :func:`shares_face` of the boxes.
+    wrap (no neighbour there).  ``edges`` is :func:`shares_face` of the boxes.  With ``source`` (n,)
+    bool, only the rows whose box a is marked are returned.
     """
     level = np.asarray(level, dtype=np.int64)
     edges = shares_face(level, ijk, depth, periodic=periodic)
@@ -313,6 +314,9 @@ def directed_face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int, periodic
     lo, hi = ijk << shift, (ijk + 1) << shift
     nfine = np.int64(1) << depth
     a, b = edges
+    if source is not None:
+        near = source[a] | source[b]
+        a, b = a[near], b[near]
     rows = []
     for ax in range(3):
         others = [o for o in range(3) if o != ax]
@@ -324,6 +328,8 @@ def directed_face_pairs(level: np.ndarray, ijk: np.ndarray, depth: int, periodic
             rows.append(np.stack([p[m], q[m], np.full(int(m.sum()), 2 * ax + 1)]))
             rows.append(np.stack([q[m], p[m], np.full(int(m.sum()), 2 * ax)]))
     pairs = np.concatenate(rows, axis=1)
+    if source is not None:
+        pairs = pairs[:, source[pairs[0]]]
     border = np.zeros((len(level), 6), dtype=bool)
     for ax in range(3):
         if not periodic[ax]:

@@ -327,7 +327,10 @@ def _ranks(paving, leaf, sig, kind, opt_node, opt_mask) -> tuple[np.ndarray, np.
     Returns (rank, the option that ranked each node or -1)."""
     v = leaf.size
     n = len(paving.level)
-    pairs, border, _ = directed_face_pairs(paving.level, paving.ijk, paving.depth, periodic=(False, False, False))
+    source = np.zeros(n, dtype=bool)
+    source[leaf[opt_node]] = True
+    pairs, border, _ = directed_face_pairs(paving.level, paving.ijk, paving.depth, periodic=(False, False, False),
+                                           source=source)
     start = np.searchsorted(leaf, np.arange(n + 1))
     index = np.flatnonzero(~(opt_mask & border[leaf[opt_node]]).any(axis=1))  # a face on the border: nothing proved
     opt_node, opt_mask = opt_node[index], opt_mask[index]
