@@ -37,6 +37,7 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval, sign_label
 from intervalkin.solve.simple_roots import ReducedBoxes
+from intervalkin.solve.window_fold import window_kinds
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_retractions", "cusp_windows"]
@@ -71,9 +72,7 @@ class CuspRetractions:
 
 def cusp_windows(models: WindowModels) -> np.ndarray:
     """(w,) bool: the windows of degree 3 whose end signs differ, with end signs and sign of D proved over the box."""
-    ends = models.end_signs.astype(np.int64)
-    firm = (ends != 0).all(axis=1) & (models.d_sign != 0)
-    return firm & (models.degree == 3) & (ends[:, 0] != ends[:, 1])
+    return window_kinds(models)[2]
 
 
 def cusp_retractions(geometry: Geometry, models: WindowModels, rows: np.ndarray,
@@ -179,7 +178,8 @@ def _lifted_faces(f_r: list[Interval], f_phi_r: list[Interval], u: np.ndarray, v
             sk = _sign_over(gu * fv - gv * fu, owner, at, m)
         else:  # d/dt g(t) where f may vanish: f_phi,r between the root and t, the r-slopes at the root
             between = sets["between"]
-            k = _hull(gu, owner, between, m) * _hull(fv, owner, at, m) - _hull(gv, owner, between, m) * _hull(fu, owner, at, m)
+            k = (_hull(gu, owner, between, m) * _hull(fv, owner, at, m)
+                 - _hull(gv, owner, between, m) * _hull(fu, owner, at, m))
             sk = np.where(k.lo > 0, 1, np.where(k.hi < 0, -1, 0))
         drive = e0 * sk * sv * (1 if side == 1 else -1)  # the sign d that keeps the side (0: none proved)
         moving = np.zeros(m, dtype=bool)

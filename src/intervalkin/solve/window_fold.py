@@ -49,7 +49,7 @@ from intervalkin.solve.window_count import window_signature
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced", "fold_piece",
-           "extreme_corners", "base_signature", "pair_windows", "pair_slopes", "pair_direction_signs"]
+           "extreme_corners", "base_signature", "window_kinds", "pair_windows", "pair_slopes", "pair_direction_signs"]
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
@@ -112,7 +112,7 @@ def window_folds(geometry: Geometry, models: WindowModels, halvings: int = CRITI
     """
     n = len(models.ok)
     ends = models.end_signs.astype(np.int64)
-    firm, even, cusp = _window_kinds(models)
+    firm, even, cusp, _ = window_kinds(models)
     cusp = ~firm | cusp  # decided only at points: treated like a cusp window
     box = models.window_box
     n_pair = np.bincount(box, weights=even, minlength=n)
@@ -150,8 +150,7 @@ def base_signature(models: WindowModels) -> np.ndarray:
     sign of D); meaningful for modelled boxes."""
     n = len(models.ok)
     ends = models.end_signs.astype(np.int64)
-    firm, even, _ = _window_kinds(models)
-    constant = firm & (models.degree == 2) & ~even
+    constant = window_kinds(models)[3]
     det_pos = constant & ((DET_SIGN * models.d_sign.astype(np.int64) * np.where(ends[:, 0] < 0, 1, -1)) > 0)
     box = models.window_box
     base = models.off.copy()
@@ -163,7 +162,7 @@ def base_signature(models: WindowModels) -> np.ndarray:
 
 def pair_windows(models: WindowModels) -> np.ndarray:
     """(w,) bool: the pair windows (end signs equal and sign of D, both proved over the whole box: 0 or 2 roots)."""
-    return _window_kinds(models)[1]
+    return window_kinds(models)[1]
 
 
 def pair_slopes(geometry: Geometry, models: WindowModels, rows: np.ndarray,
@@ -171,29 +170,20 @@ def pair_slopes(geometry: Geometry, models: WindowModels, rows: np.ndarray,
     """(w, 3) int8 per window of ``models``: for the pair windows of boxes ``rows``, the certified sign of
     s df/dr_l (s the common end sign) over R^2 x the window's critical pieces, that is the direction in
     which u = min s f over the window grows along rho_l (0: not certified); 0 for the other windows."""
-    w = len(models.degree)
-    rows = np.asarray(rows, dtype=np.int64)
-    even = pair_windows(models) & np.isin(models.window_box, rows)
-    if not even.any():
-        return np.zeros((w, 3), dtype=np.int8)
-    on = np.isin(models.piece_window, np.flatnonzero(even))
-    row = np.full(len(models.ok), -1, dtype=np.int64)
-    row[rows] = np.arange(rows.size)
-    out = _slopes(ReducedBoxes(geometry, models.boxes[rows]), row[models.window_box],
-                  models.end_signs[:, 0].astype(np.int64), w, models.piece_window[on], models.piece_lo[on],
-                  models.piece_hi[on], halvings)
-    out[~even] = 0
-    return out
+    signs, free = pair_direction_signs(geometry, models, rows, np.eye(3), halvings)
+    signs[free] = 1  # u > 0 on the whole box: every direction keeps it
+    return signs
 
 
-def _window_kinds(models: WindowModels) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(firm, pair, cusp) per window: end signs and sign of D proved over the whole box (a window that is not firm
-    is decided only at points); a firm window with equal end signs (0 or 2 roots); a firm window of degree 3
-    with end signs that differ (1 or 3 roots)."""
+def window_kinds(models: WindowModels) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(firm, pair, cusp, constant) per window: end signs and sign of D proved over the whole box (a window that
+    is not firm is decided only at points); a firm window with equal end signs (0 or 2 roots); a firm window of
+    degree 3 with end signs that differ (1 or 3 roots); a firm window of degree 2 with end signs that differ
+    (exactly one root)."""
     ends = models.end_signs.astype(np.int64)
     firm = (ends != 0).all(axis=1) & (models.d_sign != 0)
     even = firm & (ends[:, 0] == ends[:, 1])
-    return firm, even, firm & (models.degree == 3) & ~even
+    return firm, even, firm & (models.degree == 3) & ~even, firm & (models.degree == 2) & ~even
 
 
 def why_not_pieced(models: WindowModels, folds: WindowFolds) -> np.ndarray:
@@ -201,7 +191,7 @@ def why_not_pieced(models: WindowModels, folds: WindowFolds) -> np.ndarray:
     connected, -1 for window-clear boxes, window folds and boxes without a model.  The classes follow the windows'
     kinds as :func:`window_folds` reads them (a label for reports, not a claim)."""
     n = len(models.ok)
-    firm, even, cusp = _window_kinds(models)
+    firm, even, cusp, _ = window_kinds(models)
     box = models.window_box
     count = [np.bincount(box, weights=w, minlength=n) > t for w, t in ((cusp, 0), (~firm, 0), (even, 1), (even, 0))]
     out = np.full(n, -1, dtype=np.int8)

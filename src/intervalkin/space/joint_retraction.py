@@ -50,7 +50,8 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.paving.adjacency import directed_face_pairs
 from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
-from intervalkin.solve.window_fold import CLEAR, FOLD, PAIR, base_signature, pair_direction_signs, pair_windows
+from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, base_signature, pair_direction_signs, pair_windows,
+                                          window_kinds)
 
 __all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_PAIR_WINDOWS", "JointRetraction", "retract_joint_paving"]
 
@@ -131,7 +132,8 @@ class JointRetraction:
             if at.any():
                 leaves = np.unique(self.leaf[at & left])
                 by_source[name] = {"nodes": int(at.sum()), "unresolved": int((at & left).sum()),
-                                   "leaves_unresolved": int(leaves.size), "volume_unresolved": float(volume[leaves].sum())}
+                                   "leaves_unresolved": int(leaves.size),
+                                   "volume_unresolved": float(volume[leaves].sum())}
         leaves = np.unique(self.leaf[left])
         return {"closed": self.closed(), "nodes": int(self.leaf.size), "sinks": int((self.kind == SINK).sum()),
                 "resolved": int(((self.kind == RET) & ~left).sum()), "unresolved": int(left.sum()),
@@ -263,7 +265,8 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
     pair = pair_windows(models)
     box = models.window_box
     n = len(models.ok)
-    only_pairs = np.bincount(box, weights=~pair & ~_constant(models), minlength=n) == 0
+    constant = window_kinds(models)[3]
+    only_pairs = np.bincount(box, weights=~pair & ~constant, minlength=n) == 0
     n_pair = np.bincount(box, weights=pair, minlength=n)
     rows = np.flatnonzero(models.ok & ~np.isin(folds.kind, (CLEAR, FOLD)) & only_pairs & (n_pair >= 1))
     if rows.size:
@@ -287,7 +290,7 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
     # one cusp window, the others of fixed count: a node for each side (one root, three roots), lifted paths
     cusp = cusp_windows(models)
     n_cusp = np.bincount(box, weights=cusp, minlength=n)
-    others = np.bincount(box, weights=~cusp & ~_constant(models), minlength=n) == 0
+    others = np.bincount(box, weights=~cusp & ~constant, minlength=n) == 0
     crows = np.flatnonzero(models.ok & ~np.isin(folds.kind, (CLEAR, FOLD)) & (n_cusp == 1) & others)
     if crows.size:
         lifted = cusp_retractions(geometry, models, crows)
@@ -299,12 +302,6 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
     done[rows] = True
     done[crows] = True
     return np.flatnonzero(~done)
-
-
-def _constant(models) -> np.ndarray:
-    """(w,) bool: windows of degree 2 with box-wide end signs that differ and sign of D (exactly one root)."""
-    ends = models.end_signs.astype(np.int64)
-    return ((ends != 0).all(axis=1) & (models.d_sign != 0) & (models.degree == 2) & (ends[:, 0] != ends[:, 1]))
 
 
 def retract_joint_paving(jp, geometry: Geometry) -> JointRetraction:
