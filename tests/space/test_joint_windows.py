@@ -13,6 +13,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 import numpy as np
+import pytest
 
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.window_fold import CLEAR, FOLD
@@ -123,15 +124,30 @@ def test_npz_columns_of_window_pieces(fold_paving, paper_geometry):
     assert np.all((near[0][same] == cols["count_below"][leaf][same]) | (near[0][same] == cols["count_above"][leaf][same]))
 
 
-def test_leaves_whose_model_fails_are_split_and_their_children_modelled(fold_paving, paper_geometry):
+@pytest.fixture(scope="module")
+def paving_with_failed_models(paper_geometry):
+    """A depth-3 paving with window models whose gap bound at the zeros of D is switched off: since that bound
+    (proofs/lemma-gap-at-d-zeros.md) no leaf of the paper's pavings fails its model, and without it the
+    leaves near the spurious plane f(phi_D; r) = 0 fail as they used to (95 split here)."""
+    import intervalkin.solve.window_model as wm
+    from intervalkin.space.joint_paving import pave_joint_space
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(wm, "gap_positive", lambda geometry, boxes, owner, lo, hi: np.zeros(len(owner), dtype=bool))
+        return pave_joint_space(paper_geometry, 3, 1, fold=True, model_levels=1, windows=True, workers=1)
+
+
+def test_leaves_whose_model_fails_are_split_and_their_children_modelled(paving_with_failed_models, paper_geometry,
+                                                                      monkeypatch):
     """window_refinement: a leaf whose window model fails is replaced by its eight children (up to
     WINDOW_LEVELS times), so a failed model is left only on leaves that many levels finer than the paving's
     other leaves; the leaves stay a partition of the joint box, and the children's models are their own."""
+    import intervalkin.solve.window_model as wm
     from intervalkin.solve.window_model import window_models
     from intervalkin.space.joint_windows import WINDOW_LEVELS
 
-    w, p = fold_paving.windows, fold_paving.paving
-    st = fold_paving.fold_stats["windows"]
+    w, p = paving_with_failed_models.windows, paving_with_failed_models.paving
+    st = paving_with_failed_models.fold_stats["windows"]
     assert st["leaves_split"] > 0
     assert np.isclose(p.volume().sum(), np.prod(np.diff(p.domain, axis=1)))
     failed = w.leaf[~w.models.ok]
@@ -140,6 +156,7 @@ def test_leaves_whose_model_fails_are_split_and_their_children_modelled(fold_pav
     rows = np.flatnonzero(w.models.ok)[-12:]  # the last rows: children of split leaves
     boxes = np.stack([p.lo[w.leaf[rows]], p.hi[w.leaf[rows]]], axis=-1)
     assert np.array_equal(w.models.boxes[rows], boxes)
+    monkeypatch.setattr(wm, "gap_positive", lambda geometry, boxes, owner, lo, hi: np.zeros(len(owner), dtype=bool))
     again = window_models(paper_geometry, boxes)
     assert np.array_equal(again.degree, w.models.take(rows).degree)
     assert WINDOW_LEVELS >= 1

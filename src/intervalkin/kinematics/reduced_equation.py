@@ -23,6 +23,10 @@ determine a quadratic exactly.  Each entry is then enclosed by two floats.
 The determinant D(phi) = m_2 x m_3 of the 2 x 2 position system does not depend on r:
 D(phi) = d_0 + d_1 cos phi + d_2 sin phi (``denominator``).
 
+Near the zeros of D (``aligned_numerator``): there m_3 is parallel to m_2, N to the normal of m_2, and
+f = |N|^2 >= 0 has a double root on a whole plane of r-space; with s = m_2 x N (affine in r),
+f >= s^2 / |m_2|^2 - r_1 D^2 everywhere, with equality where D = 0 (proofs/lemma-gap-at-d-zeros.md).
+
 What is certified: ``reduced_equation(geometry)`` returns float intervals
 that contain the exact entries of C.  The polarisation identity is exact for a
 polynomial of degree 2, and ``tests/solve/test_simple_roots.py`` compares the form
@@ -40,9 +44,10 @@ from flint import arb, ctx
 from intervalkin.core.exact import arb_to_bounds
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
-from intervalkin.kinematics.sextic import reduction
+from intervalkin.kinematics.sextic import aligned_laurent, reduction
 
-__all__ = ["MONOMIALS", "HARMONICS", "ReducedEquation", "reduced_equation", "denominator"]
+__all__ = ["MONOMIALS", "HARMONICS", "ReducedEquation", "reduced_equation", "denominator", "AlignedNumerator",
+           "aligned_numerator"]
 
 #: Exponent pairs of the monomials in r (() is the constant, (i,) is r_i, (i, j) is r_i r_j).
 MONOMIALS: tuple[tuple[int, ...], ...] = ((), (0,), (1,), (2,), (0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
@@ -129,3 +134,38 @@ def denominator(geometry: Geometry) -> Interval:
         values = [D[0].real, 2 * d1.real, -2 * d1.imag] if d1 is not None else [D[0].real, arb(0), arb(0)]
         bounds = [arb_to_bounds(v) for v in values]
     return Interval(np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds]))
+
+
+@dataclass(frozen=True, eq=False)
+class AlignedNumerator:
+    """s(phi; r) = sum_h basis_h(phi) (S[h, 0] + sum_i S[h, i] r_i) and |m_2(phi)|^2 = sum_h basis_h(phi) L[h].
+
+    basis = (1, cos phi, sin phi, cos 2 phi, sin 2 phi, cos 3 phi, sin 3 phi), as in
+    :data:`intervalkin.kinematics.reduced_equation.HARMONICS`.
+
+    Attributes
+    ----------
+    coefficients : Interval (7, 4), enclosures of S.
+    leg_square : Interval (7,), enclosures of L.
+    """
+
+    coefficients: Interval
+    leg_square: Interval
+
+
+@functools.lru_cache(maxsize=32)
+def aligned_numerator(geometry: Geometry) -> AlignedNumerator:
+    """The coefficients of s = m_2 x N and of |m_2|^2 for ``geometry``: near the zeros of D the reduced equation
+    is bounded below by s^2 / |m_2|^2 - r_1 D^2, which a box enclosure of f cannot see (proofs/lemma-gap-at-d-zeros.md).
+    s is affine in r: its values at r = 0 and r = e_i determine it exactly."""
+    with ctx.workprec(_PRECISION):
+        base, leg = aligned_laurent(geometry, [arb(0)] * 3)
+        base = _fourier(base)
+        columns = [base] + [[x - b for x, b in zip(_fourier(aligned_laurent(geometry, [arb(int(i == j)) for j in range(3)])[0]), base)]
+                            for i in range(3)]
+        lo, hi = np.empty((7, 4)), np.empty((7, 4))
+        for m, col in enumerate(columns):
+            for h, value in enumerate(col):
+                lo[h, m], hi[h, m] = arb_to_bounds(value)
+        bounds = [arb_to_bounds(v) for v in _fourier(leg)]
+    return AlignedNumerator(Interval(lo, hi), Interval(np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds])))

@@ -43,7 +43,7 @@ from fractions import Fraction
 
 from intervalkin.core.geometry import Geometry
 
-__all__ = ['Reduction', 'reduction', 'laurent_value', 'sextic_coefficients', 'choose_shift']
+__all__ = ['Reduction', 'reduction', 'aligned_laurent', 'laurent_value', 'sextic_coefficients', 'choose_shift']
 
 
 # --------------------------------------------------------------------------------------
@@ -141,6 +141,20 @@ def reduction(geometry: Geometry, rho_sq) -> Reduction:
     for kk in (4, -4):  # structurally absent (N has no omega^-2 term)
         f.pop(kk, None)
     return Reduction(D=D, N=N, f=f, a1=a1)
+
+
+def aligned_laurent(geometry: Geometry, rho_sq) -> tuple[dict, dict]:
+    """(m_2 x N, |m_2|^2) as Laurent polynomials at the current precision (rho_sq: exact arb squares).
+
+    Where D = 0, N is parallel to the normal of m_2 and f = |N|^2 = (m_2 x N)^2 / |m_2|^2; everywhere
+    f >= (m_2 x N)^2 / |m_2|^2 - r_1 D^2 (proofs/lemma-gap-at-d-zeros.md).
+    """
+    from flint import acb, ctx
+
+    p, a, _ = _constants(geometry, ctx.prec)
+    m2 = _lscale({1: p[1], 0: -a[1]}, 2)
+    along = _lmul(_lconj(m2), reduction(geometry, rho_sq).N)  # m x n = Im(conj(m) n) for plane vectors as complex numbers
+    return _lscale(_ladd(along, _lconj(along), -1), acb(0, -0.5)), _lmul(m2, _lconj(m2))
 
 
 def sextic_coefficients(red: Reduction, phi0: float):

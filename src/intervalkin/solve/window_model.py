@@ -43,7 +43,7 @@ from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, PI_LO, sign_label
 from intervalkin.solve.simple_roots import PIECES, ReducedBoxes, initial_pieces
-from intervalkin.solve.window_split import cut_at_d_zeros, denominator_enclosure, sub_windows
+from intervalkin.solve.window_split import D_GAP, cut_at_d_zeros, d_zeros, denominator_enclosure, gap_positive, sub_windows
 
 __all__ = ["WindowModels", "window_models", "cut_interval", "denominator_enclosure", "DET_SIGN",
            "WINDOW_HALVINGS", "DEGREE_HALVINGS", "POINT_HALVINGS", "POINT_CROWD"]
@@ -152,15 +152,23 @@ def cut_interval(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.where(seam, -PI_HI * (x < 0) + PI_LO * (x > 0), x), np.where(seam, -PI_LO * (x < 0) + PI_HI * (x > 0), x)
 
 
-def _settle(data: ReducedBoxes, n: int, pieces: int, halvings: int):
+def _settle(geometry: Geometry, boxes: np.ndarray, data: ReducedBoxes, n: int, pieces: int, halvings: int):
     """Every piece, settled or open: (owner, lo, hi, kind, sign) sorted by owner and lo.
 
     kind 0: f != 0 on R^2 x piece (sign: of f); 1: df/dphi != 0 (sign: of df/dphi); 2: open.
+    The circle is cut at phi_D +- D_GAP around each zero phi_D of D: f = |N|^2 >= 0 there, and where the
+    gap piece is proved f > 0 (:func:`~intervalkin.solve.window_split.gap_positive`) no window spans phi_D.
     """
     owner, lo, hi = initial_pieces(n, pieces)
+    owner, lo, hi = cut_at_d_zeros(geometry, owner, lo, hi, np.ones(n, dtype=bool))
+    zeros = d_zeros(geometry)
     out: list[tuple] = []
     for round_ in range(halvings + 1):
         sf = sign_label(data.enclosure(owner, lo, hi, 0))
+        gap = np.flatnonzero((sf == 0) & (hi - lo <= 4 * D_GAP)
+                             & ((lo[:, None] <= zeros) & (zeros <= hi[:, None])).any(axis=1))
+        if gap.size:
+            sf[gap[gap_positive(geometry, boxes, owner[gap], lo[gap], hi[gap])]] = 1
         kind, sign = np.where(sf != 0, 0, 2).astype(np.int8), sf.copy()
         idx = np.flatnonzero(sf == 0)
         if idx.size:
@@ -239,7 +247,7 @@ def window_models(geometry: Geometry, boxes: np.ndarray, pieces: int = PIECES, h
 def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, degree_halvings: int) -> WindowModels:
     n = len(boxes)
     data = ReducedBoxes(geometry, boxes)
-    owner, lo, hi, kind, sign = _settle(data, n, pieces, halvings)
+    owner, lo, hi, kind, sign = _settle(geometry, boxes, data, n, pieces, halvings)
     m = owner.size
     first, count = np.searchsorted(owner, np.arange(n)), np.bincount(owner, minlength=n)
     pos = np.arange(m) - first[owner]

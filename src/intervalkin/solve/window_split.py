@@ -22,10 +22,10 @@ import numpy as np
 
 from intervalkin.core.ball import Ball, cos_sin_multiple
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.interval import PI_HI, Interval, sign_label
-from intervalkin.kinematics.reduced_equation import denominator
+from intervalkin.core.interval import PI_HI, Interval, certainly_positive, sign_label
+from intervalkin.kinematics.reduced_equation import aligned_numerator, denominator
 
-__all__ = ["denominator_enclosure", "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
+__all__ = ["denominator_enclosure", "gap_positive", "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
 
 #: Half-width of the gap cut around each zero of D in a D-open window.
 D_GAP = 1e-9
@@ -34,7 +34,8 @@ D_HALVINGS = 12
 
 
 def denominator_enclosure(geometry: Geometry, lo: np.ndarray, hi: np.ndarray) -> Interval:
-    """Enclosure of D(phi) = d_0 + d_1 cos phi + d_2 sin phi over [lo, hi] (mean value form and natural form)."""
+    """Enclosure of D(phi) = d_0 + d_1 cos phi + d_2 sin phi over [lo, hi] (mean value form and natural form, and
+    the hull of the end values where D' has one sign)."""
     d = Ball.from_interval(denominator(geometry))
     piece = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
 
@@ -44,8 +45,45 @@ def denominator_enclosure(geometry: Geometry, lo: np.ndarray, hi: np.ndarray) ->
         return trig + d[0] if deriv == 0 else trig
 
     at_mid = value(Ball.point(piece.mid), 0)
-    mv = (at_mid + value(piece, 1) * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
-    return mv.intersect(value(piece, 0).to_interval())
+    slope = value(piece, 1)
+    mv = (at_mid + slope * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
+    out = mv.intersect(value(piece, 0).to_interval())
+    # where D is proved monotone on the piece, its range is the hull of its end values: this keeps a piece
+    # that ends next to a zero of D (a gap cut, d_zeros) signed, where the centred form spreads too far
+    monotone = sign_label(slope.to_interval()) != 0
+    if monotone.any():
+        ends = [value(Ball.from_interval(Interval(x, x)), 0).to_interval()
+                for x in np.broadcast_arrays(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64))]
+        hull = ends[0].hull(ends[1])
+        out = Interval(np.where(monotone, np.maximum(out.lo, hull.lo), out.lo),
+                       np.where(monotone, np.minimum(out.hi, hull.hi), out.hi))
+    return out
+
+
+def gap_positive(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(m,) bool: f > 0 proved over R^2 x [lo, hi], R = boxes[owner], by f >= s^2 / |m_2|^2 - r_1 D^2
+    (:func:`intervalkin.kinematics.reduced_equation.aligned_numerator`): the bound that sees f = |N|^2 > 0 near a zero of D,
+    where the Taylor form of f cancels.  s is affine in r, so its range over R^2 is enclosed as a product of
+    balls; everything is outward-rounded."""
+    aligned = aligned_numerator(geometry)
+    phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
+    mids, rads = [np.ones(phi.mid.shape)], [np.zeros(phi.mid.shape)]
+    for k in (1, 2, 3):
+        for b in cos_sin_multiple(phi, k):
+            mids.append(b.mid), rads.append(b.rad)
+    basis = Ball(np.stack(mids, axis=-1), np.stack(rads, axis=-1))  # (m, 7)
+    coef = basis.matmul(Ball.from_interval(aligned.coefficients))  # (m, 4): s = c_0 + sum_i c_i r_i
+    leg = basis.matmul(Ball.from_interval(Interval(aligned.leg_square.lo[:, None], aligned.leg_square.hi[:, None])))
+    box = np.asarray(boxes, dtype=np.float64)[owner]
+    r = [Interval(box[:, i, 0], box[:, i, 1]).sqr() for i in range(3)]
+    s = coef[:, 0]
+    for i in range(3):
+        s = s + coef[:, 1 + i] * Ball.from_interval(r[i])
+    leg_i = leg[:, 0].to_interval()
+    positive_leg = certainly_positive(leg_i)
+    bound = s.to_interval().sqr() / Interval(np.where(positive_leg, leg_i.lo, 1.0), np.where(positive_leg, leg_i.hi, 1.0))
+    bound = bound - r[0] * denominator_enclosure(geometry, lo, hi).sqr()
+    return positive_leg & certainly_positive(bound)
 
 
 def d_zeros(geometry: Geometry) -> np.ndarray:

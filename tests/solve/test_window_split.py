@@ -1,0 +1,131 @@
+"""The reduced equation near the zeros of D (kinematics.reduced_equation.aligned_numerator, solve.window_split).
+
+- in arb, f - (s^2 / |m_2|^2 - r_1 D^2) = |N|^2 - (m_2 x N)^2 / |m_2|^2 >= 0 at random (phi, r), and it
+  vanishes at the zeros of D (N parallel to the normal of m_2 there): the identity the gap bound rests on;
+- ``gap_positive`` on random boxes near the two zeros of D: wherever it says f > 0, 50-digit arb finds
+  f > 0 at sampled (phi, r) of the gap piece; it says so on most boxes the plane f(phi_D; r) = 0 misses,
+  and never on a box that holds a point of that plane (where f(phi_D) = 0: a bound without the square,
+  or with the wrong sign of r_1 D^2, claims those);
+- ``denominator_enclosure`` (with its monotone hull) holds D at sampled points of each piece, and signs
+  the pieces that end next to a zero of D.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from flint import arb, ctx, fmpq
+
+from intervalkin.kinematics.reduced_equation import HARMONICS, aligned_numerator
+from intervalkin.kinematics.sextic import laurent_value, reduction
+from intervalkin.solve.window_split import D_GAP, d_zeros, denominator_enclosure, gap_positive
+
+
+def _q(v):
+    return fmpq(v.numerator, v.denominator)
+
+
+def _arb_parts(geometry, r, phi):
+    """(f, |N|^2, m_2 x N, |m_2|^2, D) in arb at r (three floats) and phi (a float), 200 bits."""
+    red = reduction(geometry, [arb(float(v)) for v in r])
+    ph = arb(float(phi))
+    n = laurent_value(red.N, ph)
+    p = [geometry.platform_point(i) for i in range(3)]
+    a = [(_q(bx - geometry.base[0][0]), _q(by - geometry.base[0][1])) for bx, by in geometry.base]
+    c, s = ph.cos(), ph.sin()
+    px, py = p[1][0].arb(), p[1][1].arb()
+    m2 = (2 * (c * px - s * py - a[1][0]), 2 * (s * px + c * py - a[1][1]))
+    cross = m2[0] * n.imag - m2[1] * n.real
+    return (laurent_value(red.f, ph).real, n.real ** 2 + n.imag ** 2, cross, m2[0] ** 2 + m2[1] ** 2,
+            laurent_value(red.D, ph).real)
+
+
+def _trig(phi: float) -> np.ndarray:
+    return np.array([np.cos(k * phi) if s == 0 else np.sin(k * phi) for k, s in HARMONICS])
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_aligned_numerator_bounds_f_and_meets_it_at_the_zeros_of_d(which, paper_geometry, second_geometry, rng):
+    geometry = paper_geometry if which == "paper" else second_geometry
+    aligned = aligned_numerator(geometry)
+    with ctx.workprec(200):
+        for _ in range(40):
+            r, phi = rng.uniform(50, 1100, 3), rng.uniform(-3.1, 3.1)
+            f, n2, cross, leg, d = _arb_parts(geometry, r, phi)
+            assert (f - (cross ** 2 / leg - arb(float(r[0])) * d ** 2)).mid() >= -1e-20 * abs(float(n2.mid()))
+            # the float coefficients reproduce s and |m_2|^2
+            w = _trig(phi)
+            s_float = w @ aligned.coefficients.mid() @ np.r_[1.0, r]
+            assert abs(s_float - float(cross.mid())) <= 1e-9 * (1 + abs(s_float))
+            assert abs(w @ aligned.leg_square.mid() - float(leg.mid())) <= 1e-9 * float(leg.mid())
+        for phi in d_zeros(geometry):
+            r = rng.uniform(50, 1100, 3)
+            f, n2, cross, leg, d = _arb_parts(geometry, r, phi)
+            assert abs(float(d.mid())) < 1e-9
+            # |N|^2 = s^2 / |m_2|^2 up to the float distance to the true zero of D
+            assert abs(float((n2 - cross ** 2 / leg).mid())) <= 1e-6 * float(n2.mid())
+
+
+def _plane_point(geometry, phi, r23):
+    """r with s(phi; r) = 0 (float), r_2 and r_3 given: s is affine in r."""
+    w = _trig(phi)
+    c = w @ aligned_numerator(geometry).coefficients.mid()  # s = c0 + c1 r1 + c2 r2 + c3 r3
+    return np.array([-(c[0] + c[2] * r23[0] + c[3] * r23[1]) / c[1], *r23])
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_gap_positive_is_sound_and_refuses_boxes_on_the_spurious_plane(which, paper_geometry, second_geometry, rng):
+    geometry = paper_geometry if which == "paper" else second_geometry
+    lo_j, hi_j = float(max(geometry.rho_min)), float(min(geometry.rho_max))
+    zeros = d_zeros(geometry)
+    assert zeros.size == 2
+    proved = refused = on_plane = 0
+    with ctx.workprec(170):
+        for phi_d in zeros:
+            for k in range(90):
+                # boxes around points of the plane f(phi_D; r) = 0, shifted by 0 to 5 widths
+                r = _plane_point(geometry, phi_d, rng.uniform(lo_j ** 2, hi_j ** 2, 2))
+                if not (lo_j ** 2 < r[0] < hi_j ** 2):
+                    continue
+                width = 10 ** rng.uniform(-3, -0.5)
+                centre = np.sqrt(r) + rng.choice([0.0, 2.0, 5.0]) * width * rng.uniform(-1, 1, 3)
+                box = np.stack([centre - width / 2, centre + width / 2], axis=1)[None]
+                # s(phi_D; .) is affine in r = rho^2: its range over the box is spanned by the corners
+                corners = np.stack(np.meshgrid(*box[0] ** 2, indexing="ij"), axis=-1).reshape(-1, 3)
+                values = [_trig(phi_d) @ aligned_numerator(geometry).coefficients.mid() @ np.r_[1.0, c] for c in corners]
+                holds_plane = min(values) <= 0 <= max(values)
+                ok = gap_positive(geometry, box, np.zeros(1, dtype=np.int64), np.array([phi_d - D_GAP]),
+                                  np.array([phi_d + D_GAP]))[0]
+                if holds_plane:
+                    on_plane += 1
+                    assert not ok, "f > 0 claimed on a box that holds a zero of f(phi_D; .)"
+                    continue
+                if not ok:
+                    refused += 1
+                    continue
+                proved += 1
+                for _ in range(6):
+                    rho = box[0, :, 0] + rng.uniform(size=3) * width
+                    f = _arb_parts(geometry, rho ** 2, phi_d + rng.uniform(-D_GAP, D_GAP))[0]
+                    assert f > 0
+    assert on_plane >= 20 and proved >= 25 and refused <= proved // 10, (on_plane, proved, refused)
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_denominator_enclosure_holds_and_signs_pieces_next_to_a_gap(which, paper_geometry, second_geometry, rng):
+    geometry = paper_geometry if which == "paper" else second_geometry
+    lo = rng.uniform(-3.1, 3.0, 300)
+    hi = lo + 10 ** rng.uniform(-8, -0.5, 300)
+    enc = denominator_enclosure(geometry, lo, hi)
+    with ctx.workprec(120):
+        for i in range(0, 300, 5):
+            for t in (0.0, rng.uniform(), 1.0):
+                x = lo[i] + t * (hi[i] - lo[i])
+                d = laurent_value(reduction(geometry, [arb(0)] * 3).D, arb(x)).real
+                assert enc.lo[i] <= d.mid() <= enc.hi[i]
+    z = d_zeros(geometry)
+    left = denominator_enclosure(geometry, z - 0.05, z - D_GAP)
+    right = denominator_enclosure(geometry, z + D_GAP, z + 0.05)
+    for side in (left, right):
+        assert np.all((side.hi < 0) | (side.lo > 0))
+    assert np.all(np.sign(left.lo) * np.sign(right.lo) < 0)
