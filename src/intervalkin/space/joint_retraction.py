@@ -52,6 +52,7 @@ from intervalkin.paving.adjacency import directed_face_pairs
 from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
 from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, base_signature, pair_direction_signs, pair_windows,
                                           window_kinds)
+from intervalkin.solve.window_union import joined_windows
 
 __all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_PAIR_WINDOWS", "JointRetraction", "retract_joint_paving"]
 
@@ -261,14 +262,20 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
             options = (_EACH_FACE if code == CLEAR
                        else _single_faces(_faces_of_axis(folds.rising[rows], np.int64(1 - 2 * side))))
             nodes.add(win.leaf[rows], s, _kind(cell, s), 2, cell, options)
-    # the other modelled rows: pair windows only (besides windows of fixed count), a node per pattern
+    # the other modelled rows, their runs of sub-windows joined (solve.window_union): windows of fixed count only,
+    # one node for the whole leaf; pair windows besides them, a node per pattern
+    models = joined_windows(models)
     pair = pair_windows(models)
     box = models.window_box
     n = len(models.ok)
     constant = window_kinds(models)[3]
     only_pairs = np.bincount(box, weights=~pair & ~constant, minlength=n) == 0
     n_pair = np.bincount(box, weights=pair, minlength=n)
-    rows = np.flatnonzero(models.ok & ~np.isin(folds.kind, (CLEAR, FOLD)) & only_pairs & (n_pair >= 1))
+    open_rows = models.ok & ~np.isin(folds.kind, (CLEAR, FOLD))
+    fixed = np.flatnonzero(open_rows & only_pairs & (n_pair == 0))
+    base = base_signature(models)
+    nodes.add(win.leaf[fixed], base[fixed], RET, 2, -1, _EACH_FACE)
+    rows = np.flatnonzero(open_rows & only_pairs & (n_pair >= 1))
     if rows.size:
         signs, free = pair_direction_signs(geometry, models, rows, DIRECTIONS, halvings=PAIR_HALVINGS)
         # a free window (no critical piece: u > 0 on the whole box) never holds roots and keeps every direction,
@@ -276,7 +283,6 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
         live = pair & ~free
         n_live = np.bincount(box, weights=live, minlength=n)
         rows = rows[n_live[rows] <= MAX_PAIR_WINDOWS]
-        base = base_signature(models)
         for k in range(0, MAX_PAIR_WINDOWS + 1):
             rk = rows[n_live[rows] == k]
             if not rk.size:
@@ -300,6 +306,7 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
                       np.zeros(lifted.faces.shape[2:3] + (3,)))  # lifted paths, not segments
     done = np.isin(folds.kind, (CLEAR, FOLD))
     done[rows] = True
+    done[fixed] = True
     done[crows] = True
     return np.flatnonzero(~done)
 
