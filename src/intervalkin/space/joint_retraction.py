@@ -65,9 +65,10 @@ SOURCES = ("clear", "fold_piece", "window_piece", "pair_pattern", "cusp_side", "
 #: Window-modelled leaves with more pair windows than this that may hold roots are LEFT (2**k patterns each).
 MAX_PAIR_WINDOWS = 3
 #: Halvings of the pair windows' critical pieces before their direction signs are read.  More come out free of
-#: roots or with a proved direction: on the paper's paving 57 093 leaves stay open at 1 (8.9 s), 53 547 at 2
-#: (14.3 s), 51 605 at 3 (26.4 s).
-PAIR_HALVINGS = 2
+#: roots or with a proved direction, at a cost that grows with the joined sub-windows' many pieces: on the paper's
+#: paving 40 005 leaves stay open at 1 (21 s), 37 304 at 2 (41 s).  The retraction runs in the paper run's
+#: joint process, which the run waits for, so the cheaper setting is kept.
+PAIR_HALVINGS = 1
 _EACH_FACE = np.eye(6, dtype=bool)
 #: Directions e (in rho) tried for the patterns of pair windows: integer vectors with entries in -2..2, not
 #: multiples of one another, fewest nonzero entries first (a straight retraction along e leaves through one face
