@@ -39,6 +39,8 @@ def test_every_leaf_has_a_node_and_sinks_lie_in_counted_cells(fold_paving, retra
     # every source of node occurs on this paving, and LEFT nodes never get a rank
     assert set(np.unique(r.source)) == set(range(len(SOURCES)))
     assert np.all(r.rank[r.kind == LEFT] == -1)
+    # f has at most 6 roots: a node claiming more would be an empty set posing as a blocker
+    assert r.signature[:, 0].max() <= 6
     assert not r.closed()  # cusp windows are LEFT: no upper bound at this depth
 
 

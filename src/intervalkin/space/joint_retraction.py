@@ -54,7 +54,7 @@ from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, base_signature, pa
                                           window_kinds)
 from intervalkin.solve.window_union import joined_windows
 
-__all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_PAIR_WINDOWS", "JointRetraction", "retract_joint_paving"]
+__all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_ROOTS", "MAX_PAIR_WINDOWS", "JointRetraction", "retract_joint_paving"]
 
 #: Kinds of nodes.
 SINK, RET, LEFT = 0, 1, 2
@@ -62,6 +62,9 @@ SINK, RET, LEFT = 0, 1, 2
 #: pair windows, a side of a cusp window (one root or three), or a LEFT leaf with no model of its pieces (its
 #: signature unknown).
 SOURCES = ("clear", "fold_piece", "window_piece", "pair_pattern", "cusp_side", "no_piece_model")
+#: f is a trigonometric polynomial of degree 3 (not identically 0): no joint vector has more solutions, so a
+#: node (a pattern, a cusp side, a window fold's piece) that would hold more is empty and is dropped.
+MAX_ROOTS = 6
 #: Window-modelled leaves with more pair windows than this that may hold roots are LEFT (2**k patterns each).
 MAX_PAIR_WINDOWS = 3
 #: Halvings of the pair windows' critical pieces before their direction signs are read.  More come out free of
@@ -172,8 +175,11 @@ class _Nodes:
             face = np.argmax(options, axis=2)
             directions = np.where(one[..., None], np.eye(3)[face // 2] * (2 * (face % 2) - 1)[..., None], 0.0)
         directions = np.broadcast_to(np.asarray(directions, dtype=np.float64), options.shape[:2] + (3,))
-        self.parts.append((leaf, np.asarray(signature, dtype=np.int64).reshape(m, 3), kind,
-                           np.full(m, source, dtype=np.int8), cell, options, directions))
+        signature = np.asarray(signature, dtype=np.int64).reshape(m, 3)
+        possible = signature[:, 0] <= MAX_ROOTS  # a node of more solutions than f has roots is empty
+        self.parts.append((leaf[possible], signature[possible], kind[possible],
+                           np.full(int(possible.sum()), source, dtype=np.int8), cell[possible], options[possible],
+                           directions[possible]))
 
     def table(self):
         """(leaf, signature, kind, source, cell) sorted by leaf, and the options (node, (o, 6) mask) of RET nodes."""
