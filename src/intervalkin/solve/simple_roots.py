@@ -54,7 +54,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, Interval
 from intervalkin.kinematics.reduced_equation import HARMONICS, MONOMIALS, reduced_equation
 
-__all__ = ["initial_pieces", "open_pieces", "ReducedBoxes", "PIECES", "HALVINGS"]
+__all__ = ["initial_pieces", "open_pieces", "ReducedBoxes", "trig_basis", "PIECES", "HALVINGS"]
 
 #: Pieces of the orientation circle tried first on every box.
 PIECES = 24
@@ -68,7 +68,7 @@ _CHUNK = 4096
 _MIN_WIDTH = 2.0**-30
 
 
-def _basis(phi: Ball, deriv: int) -> Ball:
+def trig_basis(phi: Ball, deriv: int = 0) -> Ball:
     """(m, 7) balls of the deriv-th phi-derivative of the basis (1, cos phi, sin phi, ...) over phi (m,)."""
     mids, rads = [], []
     for k, is_sin in HARMONICS:
@@ -161,10 +161,10 @@ class ReducedBoxes:
             extra = (spread + second + 2.0**-40 * np.abs(centre)) * (1.0 + 2.0**-40) + 2.0**-1000
             return Ball(mid, t.rad[:, 0] + extra)
 
-        at_mid = over_r(_basis(Ball.point(piece.mid), deriv))
-        slope = over_r(_basis(piece, deriv + 1))
+        at_mid = over_r(trig_basis(Ball.point(piece.mid), deriv))
+        slope = over_r(trig_basis(piece, deriv + 1))
         mv = (at_mid + slope * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
-        natural = over_r(_basis(piece, deriv)).to_interval()
+        natural = over_r(trig_basis(piece, deriv)).to_interval()
         return mv.intersect(natural)
 
 
@@ -177,7 +177,7 @@ class ReducedBoxes:
         """
         taylor = self.taylor[owner]
         half = self.half[owner]
-        w = _basis(Ball.from_interval(Interval(lo, hi)), deriv)
+        w = trig_basis(Ball.from_interval(Interval(lo, hi)), deriv)
         t = w.dot_rows(taylor)  # (m, 4)
         q = w.matmul(Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy()))  # (m, 6)
         quad = [e for e in MONOMIALS if len(e) == 2]

@@ -24,6 +24,7 @@ from intervalkin.core.ball import Ball, cos_sin_multiple
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, Interval, certainly_positive, sign_label
 from intervalkin.kinematics.reduced_equation import aligned_numerator, denominator
+from intervalkin.solve.simple_roots import trig_basis
 
 __all__ = ["denominator_enclosure", "gap_positive", "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
 
@@ -67,11 +68,7 @@ def gap_positive(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: n
     balls; everything is outward-rounded."""
     aligned = aligned_numerator(geometry)
     phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
-    mids, rads = [np.ones(phi.mid.shape)], [np.zeros(phi.mid.shape)]
-    for k in (1, 2, 3):
-        for b in cos_sin_multiple(phi, k):
-            mids.append(b.mid), rads.append(b.rad)
-    basis = Ball(np.stack(mids, axis=-1), np.stack(rads, axis=-1))  # (m, 7)
+    basis = trig_basis(phi)  # (m, 7)
     coef = basis.matmul(Ball.from_interval(aligned.coefficients))  # (m, 4): s = c_0 + sum_i c_i r_i
     leg = basis.matmul(Ball.from_interval(Interval(aligned.leg_square.lo[:, None], aligned.leg_square.hi[:, None])))
     box = np.asarray(boxes, dtype=np.float64)[owner]

@@ -304,12 +304,11 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
     cusp = cusp_windows(models)
     n_cusp = np.bincount(box, weights=cusp, minlength=n)
     others = np.bincount(box, weights=~cusp & ~constant, minlength=n) == 0
-    crows = np.flatnonzero(models.ok & ~np.isin(folds.kind, (CLEAR, FOLD)) & (n_cusp == 1) & others)
+    crows = np.flatnonzero(open_rows & (n_cusp == 1) & others)
     if crows.size:
         lifted = cusp_retractions(geometry, models, crows)
-        base = base_signature(models)[crows]
         for side in (0, 1):
-            nodes.add(win.leaf[crows], base + lifted.adds[:, side], RET, 4, -1, lifted.faces[:, side],
+            nodes.add(win.leaf[crows], base[crows] + lifted.adds[:, side], RET, 4, -1, lifted.faces[:, side],
                       np.zeros(lifted.faces.shape[2:3] + (3,)))  # lifted paths, not segments
     done = np.isin(folds.kind, (CLEAR, FOLD))
     done[rows] = True
