@@ -5,11 +5,16 @@ from __future__ import annotations
 from fractions import Fraction
 from types import SimpleNamespace
 
+import mpmath
 import numpy as np
 import pytest
 
 from intervalkin.solve.dkp import solve
-from intervalkin.space.joint_retraction import LEFT, RET, SINK, SOURCES, _ranks, retract_joint_paving
+from intervalkin.solve.window_split import d_zeros
+from intervalkin.space.joint_retraction import LEFT, RET, SINK, SOURCES, retract_joint_paving
+from intervalkin.space.retraction_ranks import retraction_ranks
+from tests.solve.test_window_model import _d_mp, _mp_value
+from tests.solve.test_window_plane import _s_mp
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +51,8 @@ def test_every_leaf_has_a_node_and_sinks_lie_in_counted_cells(fold_paving, retra
 
 def test_ranks_follow_the_rule_across_each_exit_face(fold_paving, retraction):
     """Re-derived from the float boxes: every leaf sharing a 2-D piece of a resolved node's exit face holds no LEFT
-    node, and its nodes of the same signature are sinks or of lower rank."""
+    node, and its nodes of the same signature are sinks or of lower rank (but for those on the other side of the
+    node's own plane of double roots, which its path never reaches)."""
     r, p = retraction, fold_paving.paving
     lo, hi = p.lo, p.hi
     resolved = np.flatnonzero((r.kind == RET) & (r.rank > 0))
@@ -68,7 +74,8 @@ def test_ranks_follow_the_rule_across_each_exit_face(fold_paving, retraction):
             for b in across:
                 q = np.arange(start[b], start[b + 1])
                 assert not np.any(r.kind[q] == LEFT)
-                same = q[(r.signature[q] == r.signature[node]).all(axis=1)]
+                same = q[(r.signature[q] == r.signature[node]).all(axis=1)
+                         & ((r.side[q] == 0) | (r.side[q] != -r.side[node]))]  # not across its own plane
                 assert np.all((r.rank[same] >= 0) & (r.rank[same] < r.rank[node]))
 
 
@@ -102,6 +109,45 @@ def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retract
                 assert got is None or got == tuple(r.signature[node]), (SOURCES[source], node, y)
             checked[SOURCES[source]] += 1
     assert checked["fold_piece"] >= 10 and checked["window_piece"] >= 2 and checked["pair_pattern"] >= 20, checked
+
+
+def test_plane_side_nodes_keep_their_side_and_signature_along_the_exit(fold_paving, retraction, paper_geometry):
+    """Property test: a point of a resolved node on one side of a plane of double roots (the 50-digit sign of
+    s(phi_D; rho^2) at the zero phi_D of D), of the node's signature (no other node of its leaf and side has
+    it), keeps its side and its signature along the exit segment up to the face."""
+    r, p = retraction, fold_paving.paving
+    mpmath.mp.dps = 50
+    d_coeff = _d_mp(paper_geometry)
+    zeros = [mpmath.findroot(lambda x: _mp_value(d_coeff, x), mpmath.mpf(float(z))) for z in d_zeros(paper_geometry)]
+    sided = np.flatnonzero((r.side != 0) & (r.rank > 0))
+    assert sided.size >= 10
+    rng = np.random.default_rng(17)
+    rng.shuffle(sided)
+    checked = 0
+    for node in sided[:60]:
+        a, side = r.leaf[node], int(r.side[node])
+        phi_d = zeros[abs(side) - 1]
+        mates = (r.leaf == a) & (r.side == side) & (r.signature == r.signature[node]).all(axis=1)
+        if mates.sum() != 1:
+            continue
+        for _ in range(8):
+            x = p.lo[a] + rng.random(3) * (p.hi[a] - p.lo[a])
+            if (mpmath.sign(_s_mp(paper_geometry, x, phi_d)) == np.sign(side)
+                    and _signature(paper_geometry, x) == tuple(r.signature[node])):
+                break
+        else:
+            continue
+        e = r.option_direction[r.exit[node]]
+        assert np.any(e != 0)  # a straight path: sides are kept only along segments
+        reach = np.min(np.where(e > 0, (p.hi[a] - x) / np.where(e > 0, e, 1), np.inf))
+        reach = min(reach, np.min(np.where(e < 0, (p.lo[a] - x) / np.where(e < 0, e, -1), np.inf)))
+        for t in (0.5, 1.0):
+            y = np.clip(x + t * reach * e, p.lo[a], p.hi[a])
+            assert mpmath.sign(_s_mp(paper_geometry, y, phi_d)) == np.sign(side), (node, y)
+            got = _signature(paper_geometry, y)
+            assert got is None or got == tuple(r.signature[node]), (node, y)
+        checked += 1
+    assert checked >= 5, checked
 
 
 def _cube(depth: int):
@@ -148,7 +194,7 @@ def test_the_fixed_point_on_a_small_tiling():
     kind[past], faces[past] = RET, _faces(0)
     leaf = np.arange(n)
     opt_node, opt_face = np.nonzero(faces & (kind == RET)[:, None])
-    rank, exit_ = _ranks(t, leaf, sig, kind, opt_node, np.eye(6, dtype=bool)[opt_face])
+    rank, exit_ = retraction_ranks(t, leaf, sig, kind, opt_node, np.eye(6, dtype=bool)[opt_face])
     assert list(rank[row]) == [0, 1, 2, 3]
     assert all(opt_node[exit_[b]] == b and opt_face[exit_[b]] == 0 for b in row[1:])  # through the -x face
     assert rank[c1] == -1 and rank[c2] == -1
@@ -157,15 +203,22 @@ def test_the_fixed_point_on_a_small_tiling():
     assert rank[past] == 1
     # with the LEFT leaf made a sink of the same signature, the box behind it resolves
     kind[left], sig[left] = SINK, 1
-    rank, _ = _ranks(t, leaf, sig, kind, opt_node, np.eye(6, dtype=bool)[opt_face])
+    rank, _ = retraction_ranks(t, leaf, sig, kind, opt_node, np.eye(6, dtype=bool)[opt_face])
     assert rank[behind] == 1
     # an option of two faces needs both: (2, 1, 3) through -x (the resolved (1, 1, 3)) and +x (unresolved (3, 1, 3))
     two = at[(2, 1, 3)]
     kind[two] = RET
     kind[at[(3, 1, 3)]], faces[at[(3, 1, 3)]] = RET, _faces(1)  # its only face on the border
     both = np.array([[True, True, False, False, False, False]])
-    rank, _ = _ranks(t, leaf, sig, kind, np.r_[opt_node, two], np.r_[np.eye(6, dtype=bool)[opt_face], both])
+    rank, _ = retraction_ranks(t, leaf, sig, kind, np.r_[opt_node, two], np.r_[np.eye(6, dtype=bool)[opt_face], both])
     assert rank[at[(1, 1, 3)]] == 1 and rank[two] == -1
+    # the cycle's two boxes on opposite sides of one plane of double roots do not wait for each other; on sides
+    # of two different planes they do
+    side = np.zeros(n, dtype=np.int8)
+    for s1, s2, resolved in ((1, -1, True), (-2, 2, True), (1, 2, False), (1, 1, False)):
+        side[c1], side[c2] = s1, s2
+        rank, _ = retraction_ranks(t, leaf, sig, kind, opt_node, np.eye(6, dtype=bool)[opt_face], side)
+        assert (rank[c1] == 1 and rank[c2] == 1) if resolved else (rank[c1] == -1 and rank[c2] == -1)
 
 
 def test_the_summary_reports_the_retraction(fold_paving, retraction):
@@ -176,5 +229,8 @@ def test_the_summary_reports_the_retraction(fold_paving, retraction):
     assert block["nodes"] == retraction.leaf.size
     assert block["sinks"] + block["resolved"] + block["unresolved"] == block["nodes"]
     assert sum(v["unresolved"] for v in block["by_source"].values()) == block["unresolved"]
+    sided = retraction.side != 0
+    assert block["plane_sides"]["nodes"] == sided.sum() > 0
+    assert block["plane_sides"]["unresolved"] == (sided & (retraction.rank < 0)).sum()
     assert 0 < block["volume_unresolved"] <= fold_paving.paving.volume().sum()
     assert "retraction" not in fold_paving.open_places()

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["distinct_rows"]
+__all__ = ["distinct_rows", "ramp"]
 
 #: Multiplier of the hash (the 64-bit golden ratio, odd) and the shift that folds high bits down.
 _MIX = np.uint64(0x9E3779B97F4A7C15)
@@ -99,3 +99,10 @@ def distinct_rows(parts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     pos = np.empty(m, dtype=np.int64)
     pos[first] = np.arange(first.size)
     return first, pos[rep]
+
+
+def ramp(lengths: np.ndarray) -> np.ndarray:
+    """0, 1, ..., len - 1 for each length in turn: the offsets inside runs laid end to end."""
+    lengths = np.asarray(lengths, dtype=np.int64)
+    starts = np.repeat(np.cumsum(lengths) - lengths, lengths)
+    return np.arange(int(lengths.sum()), dtype=np.int64) - starts

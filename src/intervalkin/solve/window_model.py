@@ -46,7 +46,7 @@ from intervalkin.solve.simple_roots import PIECES, ReducedBoxes, initial_pieces
 from intervalkin.solve.window_split import D_GAP, cut_at_d_zeros, d_zeros, denominator_enclosure, gap_positive, sub_windows
 
 __all__ = ["WindowModels", "window_models", "cut_interval", "denominator_enclosure", "DET_SIGN",
-           "WINDOW_HALVINGS", "DEGREE_HALVINGS", "POINT_HALVINGS", "POINT_CROWD"]
+           "WINDOW_HALVINGS", "DEGREE_HALVINGS", "degree_signs", "uniform_sign", "POINT_HALVINGS", "POINT_CROWD"]
 
 #: At a simple root phi* of f with D(phi*) != 0: sign det A = DET_SIGN * sign D(phi*) * sign f'(phi*).
 #: det A = D g' exactly at a solution, with f = D^2 g (proofs/lemma-window-model.md, step 2).
@@ -186,7 +186,7 @@ def _settle(geometry: Geometry, boxes: np.ndarray, data: ReducedBoxes, n: int, p
     return tuple(c[order] for c in cols)
 
 
-def _uniform(values: np.ndarray, group: np.ndarray, n: int) -> np.ndarray:
+def uniform_sign(values: np.ndarray, group: np.ndarray, n: int) -> np.ndarray:
     """(n,) the common value of ``values`` over each group when it is one non-zero sign, else 0."""
     lo, hi = np.full(n, 2, dtype=np.int64), np.full(n, -2, dtype=np.int64)
     np.minimum.at(lo, group, values)
@@ -194,7 +194,7 @@ def _uniform(values: np.ndarray, group: np.ndarray, n: int) -> np.ndarray:
     return np.where((lo == hi) & (lo != 0), lo, 0)
 
 
-def _degree(geometry: Geometry, data: ReducedBoxes, box: np.ndarray, group: np.ndarray, lo: np.ndarray,
+def degree_signs(geometry: Geometry, data: ReducedBoxes, box: np.ndarray, group: np.ndarray, lo: np.ndarray,
             hi: np.ndarray, d: int, n_groups: int, halvings: int) -> tuple[np.ndarray, np.ndarray]:
     """Per group of pieces (on box ``box[group]``): the one strict sign of the d-th derivative of f over
     it, and of D (0: not proved)."""
@@ -210,7 +210,7 @@ def _degree(geometry: Geometry, data: ReducedBoxes, box: np.ndarray, group: np.n
         mid = np.minimum(np.maximum(0.5 * lo + 0.5 * hi, lo), hi)
         group, lo, hi = np.concatenate([group, group]), np.concatenate([lo, mid]), np.concatenate([mid, hi])
     w = np.concatenate(parts_w)
-    return _uniform(np.concatenate(parts_f), w, n_groups), _uniform(np.concatenate(parts_d), w, n_groups)
+    return uniform_sign(np.concatenate(parts_f), w, n_groups), uniform_sign(np.concatenate(parts_d), w, n_groups)
 
 
 def window_models(geometry: Geometry, boxes: np.ndarray, pieces: int = PIECES, halvings: int = WINDOW_HALVINGS,
@@ -280,14 +280,14 @@ def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, de
     # arcs of monotone pieces: one root when the end signs differ; sign of D at it by the endpoint rule
     mono_arc = (n_open == 0) & (n_zero == 0)
     mono = kind == 1
-    sigma = _uniform(sign[mono], arc[mono], n_arcs)
+    sigma = uniform_sign(sign[mono], arc[mono], n_arcs)
     d_piece = sign_label(denominator_enclosure(geometry, lo[mono], hi[mono])).astype(np.int64)
     # where D may vanish on a monotone piece, f > 0 at its zeros (a root with D = 0 is multiple), so the
     # root lies before the first zero (f' > 0) or after the last one (f' < 0): D there has the sign of D
     # at the piece's start or end
     end = np.where(sign[mono] > 0, lo[mono], hi[mono])
     d_end = sign_label(denominator_enclosure(geometry, *cut_interval(end))).astype(np.int64)
-    d_arc = _uniform(np.where(d_piece != 0, d_piece, d_end), arc[mono], n_arcs)
+    d_arc = uniform_sign(np.where(d_piece != 0, d_piece, d_end), arc[mono], n_arcs)
     root = mono_arc & (s_start != s_end)
     bad_arc = (mono_arc & (sigma == 0)) | (root & (d_arc == 0))
     det = DET_SIGN * sigma * d_arc
@@ -301,12 +301,12 @@ def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, de
     sel = np.flatnonzero(wmap[arc] >= 0)
     pw, plo, phi = wmap[arc[sel]], lo[sel], hi[sel]
     wbox, n_p = arc_box[win_arc], pw.size
-    f2p, d2p = _degree(geometry, data, wbox[pw], np.arange(n_p), plo, phi, 2, n_p, degree_halvings)
-    f2, d2 = _uniform(f2p, pw, n_win), _uniform(d2p, pw, n_win)
+    f2p, d2p = degree_signs(geometry, data, wbox[pw], np.arange(n_p), plo, phi, 2, n_p, degree_halvings)
+    f2, d2 = uniform_sign(f2p, pw, n_win), uniform_sign(d2p, pw, n_win)
     pair = (f2 != 0) & (d2 != 0)
     rest = np.flatnonzero(~pair[pw])
-    f3p, d3p = _degree(geometry, data, wbox[pw], rest, plo[rest], phi[rest], 3, n_p, degree_halvings)
-    f3, d3 = _uniform(f3p[rest], pw[rest], n_win), _uniform(d3p[rest], pw[rest], n_win)
+    f3p, d3p = degree_signs(geometry, data, wbox[pw], rest, plo[rest], phi[rest], 3, n_p, degree_halvings)
+    f3, d3 = uniform_sign(f3p[rest], pw[rest], n_win), uniform_sign(d3p[rest], pw[rest], n_win)
     triple = ~pair & (f3 != 0) & (d3 != 0)
     # D-open windows (d_sign 0 unless the other pass proved it), then the rest cut into sub-windows
     loose = ~pair & ~triple
@@ -323,7 +323,7 @@ def _chunk(geometry: Geometry, boxes: np.ndarray, pieces: int, halvings: int, de
     first = np.flatnonzero(run_start)
     last = np.r_[first[1:], n_p][:first.size] - 1
     rw = pw[first]
-    run_d = np.where(degree[rw] > 0, d_sign[rw], _uniform(np.where(d2p != 0, d2p, d3p), run, first.size))
+    run_d = np.where(degree[rw] > 0, d_sign[rw], uniform_sign(np.where(d2p != 0, d2p, d3p), run, first.size))
     ends = np.stack([np.where(w_first[first], s_start[win_arc[rw]], 0), np.where(w_last[last], s_end[win_arc[rw]], 0)], axis=1)
     bad = np.bincount(arc_box, weights=bad_arc, minlength=n) + np.bincount(wbox[pw[split]], weights=failed, minlength=n)
     ok = has_break & (bad == 0)

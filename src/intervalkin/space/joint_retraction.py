@@ -9,7 +9,10 @@ part of U is covered by NODES, sets on which the signature is known at every poi
 * a fold box (:mod:`intervalkin.solve.fold_model`): the piece below the graph rho_k = h and the one above;
 * a window-clear leaf or a window fold (:mod:`intervalkin.solve.window_fold`): its one or two pieces;
 * a window-modelled leaf whose windows are pair windows (end signs and sign of D proved over the box:
-  0 or 2 roots) besides windows of fixed count: one node per PATTERN, which pair windows hold their two roots.
+  0 or 2 roots) besides windows of fixed count: one node per PATTERN, which pair windows hold their two roots;
+* a leaf whose D-open window holds a zero phi_D of D (:mod:`intervalkin.solve.window_plane`): the same, with that
+  window replaced by its two halves, once on each SIDE of the plane of double roots s(phi_D; rho^2) = 0 (a null
+  set, in no node), each side's nodes retracting only along directions that keep it.
 
 A node is a SINK when it lies in a counted cell (a clear leaf of it, or a piece joined to it).  A node
 RETRACTS through face f of its leaf, of outward normal d e_l, when moving along d e_l keeps every point
@@ -25,7 +28,8 @@ of the node in it up to the face:
 
 RANKS (a fixed point): a node is resolved at rank r >= 1 when, for some face f it retracts through that is not
 on the border of the joint box, every leaf across f is modelled (no LEFT node of unknown signature) and
-each of its nodes with the same signature is a sink or resolved at a rank below r.
+each of its nodes with the same signature is a sink or resolved at a rank below r (but for those on the other
+side of the node's own plane, :mod:`intervalkin.space.retraction_ranks`).
 
 Upper bound (proofs/lemma-joint-retraction.md): a point of U in a resolved node moves inside U to a face
 point, which lies in a node of signature sigma of a leaf across that face, of lower rank; so every point of
@@ -33,9 +37,9 @@ U is joined inside U to a cell of signature sigma.  When every node is a sink or
 many components as the paving has counted cells of signature sigma, and the number of basic regions is at
 most the sum of the cells' counts.  Certified: the nodes' sets come from the proved models (their
 signatures are those the paving proved); the slopes are outward-rounded enclosures.  Leaves near a cusp
-edge of g(S) (a window of one or three roots), windows decided only at points, and leaves with no model
-are LEFT: they block every node that would retract into them, so with any of them in the way no upper
-bound is claimed.
+edge of g(S) (a window of one or three roots) but for one cusp window among windows of fixed count, windows
+decided only at points that no plane explains, and leaves with no model are LEFT: they block every node that
+would retract into them, so with any of them in the way no upper bound is claimed.
 """
 
 from __future__ import annotations
@@ -48,16 +52,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.paving.adjacency import directed_face_pairs
 from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
 from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, base_signature, pair_direction_signs, pair_windows,
                                           window_kinds)
+from intervalkin.solve.window_plane import split_at_zeros_of_d
 from intervalkin.solve.window_union import joined_windows
+from intervalkin.space.retraction_ranks import LEFT, RET, SINK, retraction_ranks
 
 __all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_ROOTS", "MAX_PAIR_WINDOWS", "JointRetraction", "retract_joint_paving"]
 
-#: Kinds of nodes.
-SINK, RET, LEFT = 0, 1, 2
 #: What a node is: a clear leaf, a fold piece, a window piece (window-clear leaf or window fold), a pattern of
 #: pair windows, a side of a cusp window (one root or three), or a LEFT leaf with no model of its pieces (its
 #: signature unknown).
@@ -98,6 +101,8 @@ class JointRetraction:
     option_direction : (o, 3) float, the direction e in rho of a straight option (the segment from each point
         along e), zeros for a lifted path (:mod:`intervalkin.solve.window_cusp`).
     exit : (v,) int64, the option that ranked the node (an index into the option arrays), -1 elsewhere.
+    side : (v,) int8, 0, or +-(k + 1) for a node of a leaf cut by the k-th plane of double roots
+        (:mod:`intervalkin.solve.window_plane`): the node is the part of its pattern on the side s > 0 or s < 0.
     seconds : the time taken.
     """
 
@@ -111,6 +116,7 @@ class JointRetraction:
     option_direction: np.ndarray
     rank: np.ndarray
     exit: np.ndarray
+    side: np.ndarray
     seconds: float
 
     @property
@@ -140,10 +146,14 @@ class JointRetraction:
                                    "leaves_unresolved": int(leaves.size),
                                    "volume_unresolved": float(volume[leaves].sum())}
         leaves = np.unique(self.leaf[left])
+        sided = self.side != 0
+        plane_sides = {"nodes": int(sided.sum()), "unresolved": int((sided & left).sum()),
+                       "leaves": int(np.unique(self.leaf[sided]).size),
+                       "leaves_unresolved": int(np.unique(self.leaf[sided & left]).size)}
         return {"closed": self.closed(), "nodes": int(self.leaf.size), "sinks": int((self.kind == SINK).sum()),
                 "resolved": int(((self.kind == RET) & ~left).sum()), "unresolved": int(left.sum()),
                 "leaves_unresolved": int(leaves.size), "volume_unresolved": float(volume[leaves].sum()),
-                "largest_rank": int(self.rank.max(initial=0)), "by_source": by_source,
+                "largest_rank": int(self.rank.max(initial=0)), "by_source": by_source, "plane_sides": plane_sides,
                 "seconds": round(self.seconds, 2)}
 
 
@@ -163,7 +173,9 @@ class _Nodes:
     def __init__(self):
         self.parts: list[tuple] = []
 
-    def add(self, leaf, signature, kind, source, cell, options, directions=None):
+    def add(self, leaf, signature, kind, source, cell, options, directions=None, plane=None):
+        """``plane``: (PlaneSplit, rows) when the nodes are those of window rows, some of them cut by a plane of
+        double roots: those are added once per side, keeping only the straight options that keep the side."""
         leaf = np.asarray(leaf, dtype=np.int64)
         m = leaf.size
         kind = np.broadcast_to(np.asarray(kind, dtype=np.int8), (m,))
@@ -176,14 +188,33 @@ class _Nodes:
             directions = np.where(one[..., None], np.eye(3)[face // 2] * (2 * (face % 2) - 1)[..., None], 0.0)
         directions = np.broadcast_to(np.asarray(directions, dtype=np.float64), options.shape[:2] + (3,))
         signature = np.asarray(signature, dtype=np.int64).reshape(m, 3)
+        side = np.zeros(m, dtype=np.int8)
+        if plane is not None:
+            split, rows = plane
+            cut = split.plane[rows] != 0
+            if cut.any():
+                at = np.flatnonzero(cut)
+                keep = [np.flatnonzero(~cut)] + [at, at]
+                rising = split.rising[rows[at]].astype(np.int64)[:, None, :]
+                masks = [options[~cut]]
+                for towards in (1, -1):  # along e, s(phi_D; rho^2) never falls (rises) when every moving rho_l does
+                    e = np.sign(directions[at]).astype(np.int64)
+                    keeps = ((e == 0) | (e * rising * towards > 0)).all(axis=2) & (e != 0).any(axis=2)
+                    masks.append(options[at] & keeps[..., None])
+                order = np.concatenate(keep)
+                side = np.concatenate([np.zeros(int((~cut).sum()), np.int8)]
+                                      + [towards * split.plane[rows[at]] for towards in (1, -1)]).astype(np.int8)
+                leaf, signature, kind, cell = leaf[order], signature[order], kind[order], cell[order]
+                options, directions = np.concatenate(masks), directions[order]
         possible = signature[:, 0] <= MAX_ROOTS  # a node of more solutions than f has roots is empty
         self.parts.append((leaf[possible], signature[possible], kind[possible],
                            np.full(int(possible.sum()), source, dtype=np.int8), cell[possible], options[possible],
-                           directions[possible]))
+                           directions[possible], side[possible]))
 
     def table(self):
-        """(leaf, signature, kind, source, cell) sorted by leaf, and the options (node, (o, 6) mask) of RET nodes."""
-        cols = [np.concatenate([p[i] for p in self.parts]) for i in range(5)]
+        """(leaf, signature, kind, source, cell, side) sorted by leaf, and the options (node, (o, 6) mask) of RET
+        nodes."""
+        cols = [np.concatenate([p[i] for p in self.parts]) for i in (0, 1, 2, 3, 4, 7)]
         order = np.argsort(cols[0], kind="stable")
         new = np.empty_like(order)
         new[order] = np.arange(order.size)
@@ -269,9 +300,11 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
             options = (_EACH_FACE if code == CLEAR
                        else _single_faces(_faces_of_axis(folds.rising[rows], np.int64(1 - 2 * side))))
             nodes.add(win.leaf[rows], s, _kind(cell, s), 2, cell, options)
-    # the other modelled rows, their runs of sub-windows joined (solve.window_union): windows of fixed count only,
+    # the other modelled rows, their runs of sub-windows joined (solve.window_union) and their D-open window cut
+    # at the zero of D (solve.window_plane, nodes then on each side of the plane): windows of fixed count only,
     # one node for the whole leaf; pair windows besides them, a node per pattern
-    models = joined_windows(models)
+    split = split_at_zeros_of_d(geometry, joined_windows(models))
+    models = split.models
     pair = pair_windows(models)
     box = models.window_box
     n = len(models.ok)
@@ -281,7 +314,7 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
     open_rows = models.ok & ~np.isin(folds.kind, (CLEAR, FOLD))
     fixed = np.flatnonzero(open_rows & only_pairs & (n_pair == 0))
     base = base_signature(models)
-    nodes.add(win.leaf[fixed], base[fixed], RET, 2, -1, _EACH_FACE)
+    nodes.add(win.leaf[fixed], base[fixed], RET, 2, -1, _EACH_FACE, plane=(split, fixed))
     rows = np.flatnonzero(open_rows & only_pairs & (n_pair >= 1))
     if rows.size:
         signs, free = pair_direction_signs(geometry, models, rows, DIRECTIONS, halvings=PAIR_HALVINGS)
@@ -299,12 +332,14 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
                 real = np.array([(pattern >> i) & 1 for i in range(k)], dtype=np.int64)
                 # u_i must not fall where window i is empty, not rise where it holds its two roots
                 keeps = (signs[wins] * (1 - 2 * real)[None, :, None] == 1).all(axis=1)
-                nodes.add(win.leaf[rk], base[rk] + int(real.sum()) * PAIR, RET, 3, -1, *_direction_options(keeps))
+                at = _within_rolle(split, constant, wins, real)
+                nodes.add(win.leaf[rk[at]], base[rk[at]] + int(real.sum()) * PAIR, RET, 3, -1,
+                          *_direction_options(keeps[at]), plane=(split, rk[at]))
     # one cusp window, the others of fixed count: a node for each side (one root, three roots), lifted paths
     cusp = cusp_windows(models)
     n_cusp = np.bincount(box, weights=cusp, minlength=n)
     others = np.bincount(box, weights=~cusp & ~constant, minlength=n) == 0
-    crows = np.flatnonzero(open_rows & (n_cusp == 1) & others)
+    crows = np.flatnonzero(open_rows & (n_cusp == 1) & others & (split.plane == 0))  # lifted paths may cross a plane
     if crows.size:
         lifted = cusp_retractions(geometry, models, crows)
         for side in (0, 1):
@@ -315,6 +350,16 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
     done[fixed] = True
     done[crows] = True
     return np.flatnonzero(~done)
+
+
+def _within_rolle(split, constant: np.ndarray, wins: np.ndarray, real: np.ndarray) -> np.ndarray:
+    """(k,) bool over rows of live pair windows ``wins`` (k, c): the pattern ``real`` (c,) puts at most the whole
+    window's degree in the two halves of each cut window (a half's twin: a live pair window, or one root)."""
+    twin = split.twin[wins]
+    twin_real = (twin[:, :, None] == wins[:, None, :]).astype(np.int64) @ real
+    twin_fixed = np.where(twin >= 0, constant[np.maximum(twin, 0)], False)
+    roots = 2 * real[None, :] + 2 * twin_real + twin_fixed
+    return ((twin < 0) | (roots <= split.window_degree[wins])).all(axis=1)
 
 
 def retract_joint_paving(jp, geometry: Geometry) -> JointRetraction:
@@ -333,68 +378,8 @@ def retract_joint_paving(jp, geometry: Geometry) -> JointRetraction:
         covered[jp.windows.leaf[left_rows]] = False  # a window row without nodes: its leaf is LEFT
     left = np.flatnonzero(~covered)
     nodes.add(left, -np.ones((left.size, 3)), LEFT, len(SOURCES) - 1, -1, np.zeros((1, 6), dtype=bool))
-    (leaf, sig, kind, source, cell), opt_node, opt_mask, opt_dir = nodes.table()
-    rank, exit_ = _ranks(jp.paving, leaf, sig, kind, opt_node, opt_mask)
-    return JointRetraction(leaf, sig, kind, source, cell, opt_node, opt_mask, opt_dir, rank, exit_,
+    (leaf, sig, kind, source, cell, side), opt_node, opt_mask, opt_dir = nodes.table()
+    rank, exit_ = retraction_ranks(jp.paving, leaf, sig, kind, opt_node, opt_mask, side)
+    return JointRetraction(leaf, sig, kind, source, cell, opt_node, opt_mask, opt_dir, rank, exit_, side,
                            time.perf_counter() - t0)
 
-
-def _ranks(paving, leaf, sig, kind, opt_node, opt_mask) -> tuple[np.ndarray, np.ndarray]:
-    """The fixed point of the ranks (module docstring), a worklist over the options: an option of node N is ready
-    when, across every face of its mask, no leaf waits (a LEFT node, or a node of N's signature not yet ranked).
-    Returns (rank, the option that ranked each node or -1)."""
-    v = leaf.size
-    n = len(paving.level)
-    source = np.zeros(n, dtype=bool)
-    source[leaf[opt_node]] = True
-    pairs, border, _ = directed_face_pairs(paving.level, paving.ijk, paving.depth, periodic=(False, False, False),
-                                           source=source)
-    start = np.searchsorted(leaf, np.arange(n + 1))
-    index = np.flatnonzero(~(opt_mask & border[leaf[opt_node]]).any(axis=1))  # a face on the border: nothing proved
-    opt_node, opt_mask = opt_node[index], opt_mask[index]
-    option, face = np.nonzero(opt_mask)
-    # leaf pairs across each face, looked up by (leaf, face)
-    key = pairs[0] * 6 + pairs[2]
-    order = np.argsort(key, kind="stable")
-    key, across = key[order], pairs[1][order]
-    want = leaf[opt_node[option]] * 6 + face
-    e_lo, e_hi = np.searchsorted(key, want), np.searchsorted(key, want, side="right")
-    entry = np.repeat(option, e_hi - e_lo)
-    nb = across[np.repeat(e_lo, e_hi - e_lo) + _ramp(e_hi - e_lo)]
-    # the nodes of each neighbour leaf the option waits for: same signature, or of unknown signature
-    q = np.repeat(start[nb], start[nb + 1] - start[nb]) + _ramp(start[nb + 1] - start[nb])
-    entry = np.repeat(entry, start[nb + 1] - start[nb])
-    wait = ((sig[q, 0] < 0) | (sig[q] == sig[opt_node[entry]]).all(axis=1)) & (kind[q] != SINK)
-    entry, q = entry[wait], q[wait]
-    pending = np.bincount(entry, minlength=opt_node.size)
-    by_q = np.argsort(q, kind="stable")
-    q_sorted, entry_by_q = q[by_q], entry[by_q]
-    rank = np.where(kind == SINK, 0, -1).astype(np.int32)
-    exit_ = np.full(v, -1, dtype=np.int64)
-    ready = np.flatnonzero(pending == 0)
-    r = 0
-    while ready.size:
-        r += 1
-        ready = ready[rank[opt_node[ready]] < 0]
-        fresh, first = np.unique(opt_node[ready], return_index=True)
-        if not fresh.size:
-            break
-        rank[fresh] = r
-        exit_[fresh] = index[ready[first]]
-        lo = np.searchsorted(q_sorted, fresh)
-        hi = np.searchsorted(q_sorted, fresh, side="right")
-        hit = entry_by_q[np.repeat(lo, hi - lo) + _ramp(hi - lo)]
-        np.subtract.at(pending, hit, 1)
-        hit = np.unique(hit)
-        ready = hit[(pending[hit] == 0) & (rank[opt_node[hit]] < 0)]
-    return rank, exit_
-
-
-def _ramp(lengths: np.ndarray) -> np.ndarray:
-    """0, 1, ..., len - 1 for each length in turn."""
-    lengths = np.asarray(lengths, dtype=np.int64)
-    total = int(lengths.sum())
-    if total == 0:
-        return np.zeros(0, dtype=np.int64)
-    starts = np.repeat(np.cumsum(lengths) - lengths, lengths)
-    return np.arange(total, dtype=np.int64) - starts
