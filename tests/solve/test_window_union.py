@@ -14,7 +14,6 @@ import mpmath
 import numpy as np
 import pytest
 
-from intervalkin.solve.window_model import window_models
 from intervalkin.solve.window_union import joined_degree, joined_windows
 from tests.solve.test_window_model import _d_mp, _f_mp, _mp_value, _roots_on_circle
 
@@ -27,15 +26,10 @@ def test_joined_degree_small_cases():
 
 
 @pytest.fixture(scope="module")
-def sub_window_models(paper_geometry):
-    """Window models of the no-model leaves of a small paving that hold runs of sub-windows."""
-    from intervalkin.space.joint_paving import pave_joint_space
-
-    p = pave_joint_space(paper_geometry, 5, model_levels=1, face_levels=0)
-    none = p.cell < 0
-    if p.pieces is not None and len(p.pieces):
-        none[p.pieces.box] = False
-    models = window_models(paper_geometry, np.stack([p.paving.lo[none], p.paving.hi[none]], axis=-1))
+def sub_window_models(fold_paving):
+    """Window models of the leaves of the shared depth-5 paving that hold runs of sub-windows (its window models
+    are those of the leaves with neither a clear label nor a fold model)."""
+    models = fold_paving.windows.models
     runs = np.unique(models.window_box[np.any(models.end_signs == 0, axis=1)])
     assert runs.size >= 40
     return models.take(runs)

@@ -46,6 +46,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval, sign_label
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_count import window_signature
+from intervalkin.solve.window_split import aligned_r_slopes
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced", "fold_piece",
@@ -242,7 +243,8 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     """For the pair windows of boxes ``rows`` and each direction e (c, 3) in rho: ((w, c) int8, the certified
     sign of s D_e f = s sum_l e_l 2 rho_l df/dr_l on the window's critical pieces over R, that is the direction
     in which u = min s f moves along e (0: not certified); (w,) bool, windows with no critical piece (u > 0 on
-    the whole box)).  Other windows: 0 and False."""
+    the whole box)).  Other windows: 0 and False.  df/dr_l is the intersection of the Taylor form's enclosure
+    and :func:`~intervalkin.solve.window_split.aligned_r_slopes` (tighter near the zeros of D)."""
     w = len(models.degree)
     rows = np.asarray(rows, dtype=np.int64)
     directions = np.asarray(directions, dtype=np.float64)
@@ -259,8 +261,9 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
                            models.piece_hi[on], halvings)
     owner = row[models.window_box][pw]
     box = models.boxes[rows][owner]
-    grad = [data.r_slope(owner, lo, hi, axis) * Interval(2.0 * box[:, axis, 0], 2.0 * box[:, axis, 1])
-            for axis in range(3)]
+    aligned = aligned_r_slopes(geometry, models.boxes[rows], owner, lo, hi)
+    grad = [data.r_slope(owner, lo, hi, axis).intersect(aligned[axis])
+            * Interval(2.0 * box[:, axis, 0], 2.0 * box[:, axis, 1]) for axis in range(3)]
     free = even & (np.bincount(pw, minlength=w) == 0)
     for c, e in enumerate(directions):
         value = grad[0] * e[0] + grad[1] * e[1] + grad[2] * e[2]

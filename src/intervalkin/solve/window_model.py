@@ -43,7 +43,8 @@ from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, PI_LO, sign_label
 from intervalkin.solve.simple_roots import PIECES, ReducedBoxes, initial_pieces
-from intervalkin.solve.window_split import D_GAP, cut_at_d_zeros, d_zeros, denominator_enclosure, gap_positive, sub_windows
+from intervalkin.solve.window_split import (D_GAP, cut_at_d_zeros, d_zeros, denominator_enclosure, gap_positive,
+                                           line_misses_circle, sub_windows)
 
 __all__ = ["WindowModels", "window_models", "cut_interval", "denominator_enclosure", "DET_SIGN",
            "WINDOW_HALVINGS", "DEGREE_HALVINGS", "degree_signs", "uniform_sign", "POINT_HALVINGS", "POINT_CROWD"]
@@ -158,6 +159,8 @@ def _settle(geometry: Geometry, boxes: np.ndarray, data: ReducedBoxes, n: int, p
     kind 0: f != 0 on R^2 x piece (sign: of f); 1: df/dphi != 0 (sign: of df/dphi); 2: open.
     The circle is cut at phi_D +- D_GAP around each zero phi_D of D: f = |N|^2 >= 0 there, and where the
     gap piece is proved f > 0 (:func:`~intervalkin.solve.window_split.gap_positive`) no window spans phi_D.
+    A piece over which the line of legs 1 and 2 misses the circle of leg 1 is settled f > 0 as well
+    (:func:`~intervalkin.solve.window_split.line_misses_circle`).
     """
     owner, lo, hi = initial_pieces(n, pieces)
     owner, lo, hi = cut_at_d_zeros(geometry, owner, lo, hi, np.ones(n, dtype=bool))
@@ -169,6 +172,9 @@ def _settle(geometry: Geometry, boxes: np.ndarray, data: ReducedBoxes, n: int, p
                              & ((lo[:, None] <= zeros) & (zeros <= hi[:, None])).any(axis=1))
         if gap.size:
             sf[gap[gap_positive(geometry, boxes, owner[gap], lo[gap], hi[gap])]] = 1
+        miss = np.flatnonzero(sf == 0)
+        if miss.size:
+            sf[miss[line_misses_circle(geometry, boxes, owner[miss], lo[miss], hi[miss])]] = 1
         kind, sign = np.where(sf != 0, 0, 2).astype(np.int8), sf.copy()
         idx = np.flatnonzero(sf == 0)
         if idx.size:

@@ -13,6 +13,11 @@ Two kinds of windows of :mod:`intervalkin.solve.window_model` are not certified 
   of f at a cut between two runs holds for no certified part of the box (``end_signs`` 0 there)
   and is proved at the point.
 
+
+Two bounds read f through f |m_2|^2 = s^2 - D^2 V (proofs/lemma-line-misses-circle.md), where its terms do
+not cancel: :func:`line_misses_circle` settles pieces f > 0 where the line of legs 1 and 2 misses the circle of
+leg 1, and :func:`aligned_r_slopes` encloses df/dr_l near the zeros of D, where the Taylor form cannot sign it.
+
 Everything here is vectorised over windows, pieces and brackets.
 """
 
@@ -22,11 +27,11 @@ import numpy as np
 
 from intervalkin.core.ball import Ball, cos_sin_multiple
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.interval import PI_HI, Interval, certainly_positive, sign_label
+from intervalkin.core.interval import PI_HI, Interval, certainly_negative, certainly_positive, sign_label
 from intervalkin.kinematics.reduced_equation import aligned_numerator, denominator
 from intervalkin.solve.simple_roots import trig_basis
 
-__all__ = ["denominator_enclosure", "gap_positive", "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
+__all__ = ["denominator_enclosure", "gap_positive", "line_misses_circle", "aligned_r_slopes", "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
 
 #: Half-width of the gap cut around each zero of D in a D-open window.
 D_GAP = 1e-9
@@ -81,6 +86,60 @@ def gap_positive(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: n
     bound = s.to_interval().sqr() / Interval(np.where(positive_leg, leg_i.lo, 1.0), np.where(positive_leg, leg_i.hi, 1.0))
     bound = bound - r[0] * denominator_enclosure(geometry, lo, hi).sqr()
     return positive_leg & certainly_positive(bound)
+
+
+def line_misses_circle(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
+                       hi: np.ndarray) -> np.ndarray:
+    """(m,) bool: f > 0 proved over R^2 x [lo, hi], R = boxes[owner], because there the line m_2 . z = k_2 of
+    legs 1 and 2 misses the circle |z|^2 = r_1 of leg 1 and D != 0 (proofs/lemma-line-misses-circle.md).
+
+    With L = |m_2|^2 and k_2 = r_2 - r_1 - L / 4, f L = s^2 - D^2 V where V = r_1 L - k_2^2 (s = m_2 x N): V < 0
+    and D != 0 give f >= D^2 |V| / L > 0.  A box enclosure of f misses it where the terms of f cancel; V's
+    enclosure is a few interval operations on L, which has one harmonic."""
+    aligned = aligned_numerator(geometry)
+    phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
+    leg = trig_basis(phi).matmul(Ball.from_interval(Interval(aligned.leg_square.lo[:, None],
+                                                             aligned.leg_square.hi[:, None])))[:, 0].to_interval()
+    box = np.asarray(boxes, dtype=np.float64)[owner]
+    r1, r2 = (Interval(box[:, i, 0], box[:, i, 1]).sqr() for i in range(2))
+    v = r1 * leg - (r2 - r1 - leg * 0.25).sqr()
+    return certainly_negative(v) & (sign_label(denominator_enclosure(geometry, lo, hi)) != 0)
+
+
+def aligned_r_slopes(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
+                     hi: np.ndarray) -> list[Interval]:
+    """Enclosures of df/dr_l, l = 1, 2, 3, over R^2 x [lo, hi], R = boxes[owner], from f L = s^2 - D^2 V
+    (:func:`line_misses_circle`): L and D do not depend on r, so
+
+        df/dr_l = (2 s ds/dr_l - D^2 dV/dr_l) / L,   dV/dr_1 = L + 2 k, dV/dr_2 = -2 k, dV/dr_3 = 0,
+
+    with k = r_2 - r_1 - L / 4.  Near a zero of D, where the roots of f are close to s = 0, the two terms of
+    f no longer cancel in this form: s is affine in r and enclosed tightly (proofs/lemma-line-misses-circle.md)."""
+    aligned = aligned_numerator(geometry)
+    phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
+    basis = trig_basis(phi)
+    coef = basis.matmul(Ball.from_interval(aligned.coefficients))
+    leg = basis.matmul(Ball.from_interval(Interval(aligned.leg_square.lo[:, None],
+                                                   aligned.leg_square.hi[:, None])))[:, 0].to_interval()
+    box = np.asarray(boxes, dtype=np.float64)[owner]
+    r = [Interval(box[:, i, 0], box[:, i, 1]).sqr() for i in range(3)]
+    s = coef[:, 0]
+    for i in range(3):
+        s = s + coef[:, 1 + i] * Ball.from_interval(r[i])
+    s = s.to_interval()
+    d2 = denominator_enclosure(geometry, lo, hi).sqr()
+    k = r[1] - r[0] - leg * 0.25
+    dv = [leg + k * 2.0, k * -2.0, None]
+    positive = certainly_positive(leg)
+    leg = Interval(np.where(positive, leg.lo, 1.0), np.where(positive, leg.hi, 1.0))
+    out = []
+    for i in range(3):
+        num = s * coef[:, 1 + i].to_interval() * 2.0
+        if dv[i] is not None:
+            num = num - d2 * dv[i]
+        slope = num / leg
+        out.append(Interval(np.where(positive, slope.lo, -np.inf), np.where(positive, slope.hi, np.inf)))
+    return out
 
 
 def d_zeros(geometry: Geometry) -> np.ndarray:

@@ -13,6 +13,8 @@ part of U is covered by NODES, sets on which the signature is known at every poi
 * a leaf whose D-open window holds a zero phi_D of D (:mod:`intervalkin.solve.window_plane`): the same, with that
   window replaced by its two halves, once on each SIDE of the plane of double roots s(phi_D; rho^2) = 0 (a null
   set, in no node), each side's nodes retracting only along directions that keep it.
+* any other leaf whose windows are all firm: one node per signature they allow, with no way out (it tells a
+  neighbour of another signature that it need not wait, which a LEFT leaf cannot).
 
 A node is a SINK when it lies in a counted cell (a clear leaf of it, or a piece joined to it).  A node
 RETRACTS through face f of its leaf, of outward normal d e_l, when moving along d e_l keeps every point
@@ -55,6 +57,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
 from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, base_signature, pair_direction_signs, pair_windows,
                                           window_kinds)
+from intervalkin.solve.window_model import DET_SIGN
 from intervalkin.solve.window_plane import split_at_zeros_of_d
 from intervalkin.solve.window_union import joined_windows
 from intervalkin.space.retraction_ranks import LEFT, RET, SINK, retraction_ranks
@@ -64,7 +67,7 @@ __all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_ROOTS", "MAX_PAIR_WINDOWS", "J
 #: What a node is: a clear leaf, a fold piece, a window piece (window-clear leaf or window fold), a pattern of
 #: pair windows, a side of a cusp window (one root or three), or a LEFT leaf with no model of its pieces (its
 #: signature unknown).
-SOURCES = ("clear", "fold_piece", "window_piece", "pair_pattern", "cusp_side", "no_piece_model")
+SOURCES = ("clear", "fold_piece", "window_piece", "pair_pattern", "cusp_side", "signature_only", "no_piece_model")
 #: f is a trigonometric polynomial of degree 3 (not identically 0): no joint vector has more solutions, so a
 #: node (a pattern, a cusp side, a window fold's piece) that would hold more is empty and is dropped.
 MAX_ROOTS = 6
@@ -349,7 +352,30 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
     done[rows] = True
     done[fixed] = True
     done[crows] = True
+    _signature_nodes(models, open_rows & ~done, base, nodes, win.leaf)
+    done[open_rows & (np.bincount(box, weights=~window_kinds(models)[0], minlength=n) == 0)] = True
     return np.flatnonzero(~done)
+
+
+def _signature_nodes(models, rows: np.ndarray, base: np.ndarray, nodes: _Nodes, leaf_of_row: np.ndarray) -> None:
+    """Rows (n,) bool whose windows are all firm but fit no node above (a cusp window beside pair windows, more
+    pair windows than MAX_PAIR_WINDOWS): one node per signature they allow, with no way out.  Each cusp window adds
+    its one root (aspect by the crossing rule) and maybe a pair, each pair window maybe a pair; so the signatures
+    are base + cusp roots + j PAIR, j = 0..(pair + cusp windows).  Never ranked, but a neighbour of another
+    signature need not wait for them, as it must for a LEFT leaf."""
+    firm, even, cusp, _ = window_kinds(models)
+    box, n = models.window_box, len(models.ok)
+    rows = np.flatnonzero(rows & (np.bincount(box, weights=~firm, minlength=n) == 0))
+    if not rows.size:
+        return
+    ends = models.end_signs.astype(np.int64)
+    det_pos = cusp & ((DET_SIGN * models.d_sign.astype(np.int64) * np.where(ends[:, 0] < 0, 1, -1)) > 0)
+    root = np.stack([np.bincount(box, weights=w, minlength=n) for w in (cusp, det_pos, cusp & ~det_pos)],
+                    axis=1).astype(np.int64)
+    extra = np.bincount(box, weights=even | cusp, minlength=n).astype(np.int64)
+    for j in range(int(extra[rows].max()) + 1):
+        at = rows[extra[rows] >= j]
+        nodes.add(leaf_of_row[at], base[at] + root[at] + j * PAIR, RET, 5, -1, np.zeros((1, 6), dtype=bool))
 
 
 def _within_rolle(split, constant: np.ndarray, wins: np.ndarray, real: np.ndarray) -> np.ndarray:
