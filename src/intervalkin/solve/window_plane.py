@@ -21,8 +21,8 @@ window's degree (Rolle on W).
 
 What is proved over the box, for every r in R^2 with s(phi_D; r) != 0 (:func:`split_at_zeros_of_d`):
 
-* D is strictly monotone on the gap piece G = [phi~ - D_GAP, phi~ + D_GAP] (phi~ the float cut) and its
-  end values have opposite signs, so G holds phi_D and D has no other zero in G; every other piece of W
+* D is strictly monotone on the gap G (the window's pieces inside [phi~ - D_GAP, phi~ + D_GAP], phi~ the float
+  zero) and its end values have opposite signs, so G holds phi_D and D has no other zero in G; every other piece of W
   has a proved sign of D, the one of G's end on its side;
 * the half's degree: f^(d) of one strict sign over R^2 x (the half's pieces), which cover the half
   (G is given to both halves, so each half's pieces cover it);
@@ -100,24 +100,20 @@ def split_at_zeros_of_d(geometry: Geometry, models: WindowModels,
     if not d_open.any() or zeros.size == 0:
         return unchanged
     first, count, pw = _window_spans(models)
-    # the gap G = [z - D_GAP, z + D_GAP] around a float zero z, cut out of each D-open window's pieces
-    # (window_split.cut_at_d_zeros) and maybe bisected since: its first and last piece
+    # the gap G around a float zero z: the window's pieces inside [z - D_GAP, z + D_GAP] (window_split.cut_at_d_zeros
+    # cut there; some may have been bisected, and some settled since): its first and last piece
     lo, hi = models.piece_lo, models.piece_hi
-    starts = np.full(lo.size, -1)
-    ends = np.full(lo.size, -1)
-    for k, z in enumerate(zeros):
-        starts[lo == z - D_GAP] = k
-        ends[hi == z + D_GAP] = k
-    g_first = np.full(w, -1)
+    g_first = np.full(w, np.iinfo(np.int64).max)
     g_last = np.full(w, -1)
     g_zero = np.full(w, -1)
-    one = (np.bincount(pw, weights=starts >= 0, minlength=w) == 1) & (np.bincount(pw, weights=ends >= 0, minlength=w) == 1)
-    at = np.flatnonzero(starts >= 0)
-    g_first[pw[at]], g_zero[pw[at]] = at, starts[at]
-    at = np.flatnonzero(ends >= 0)
-    g_last[pw[at]] = at
-    cand = np.flatnonzero(d_open & one & (g_zero >= 0))
-    cand = cand[(g_last[cand] >= g_first[cand]) & (ends[np.maximum(g_last[cand], 0)] == g_zero[cand])]
+    for k, z in enumerate(zeros):
+        inside = np.flatnonzero((lo >= z - D_GAP) & (hi <= z + D_GAP) & d_open[pw])
+        np.minimum.at(g_first, pw[inside], inside)
+        np.maximum.at(g_last, pw[inside], inside)
+        g_zero[pw[inside]] = np.where(g_zero[pw[inside]] == -1, k, -2)  # -2: pieces near both zeros
+    # the pieces inside one interval are consecutive (a window's pieces are in circle order); that G holds the
+    # zero of D is proved below, by D's signs at its ends
+    cand = np.flatnonzero(d_open & (g_zero >= 0))
     if not cand.size:
         return unchanged
     g, g_end, zero = g_first[cand], g_last[cand], g_zero[cand]
