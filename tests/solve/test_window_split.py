@@ -10,6 +10,11 @@
   ``line_misses_circle`` on random boxes and pieces: wherever it says f > 0, 50-digit arb finds f > 0 and
   V < 0 at sampled points, and it never says so where a sampled point has V > 0 (with the sign of V
   reversed, the test fails);
+- ``root_direction_signs`` at roots of f beside the zeros of D (joint vectors a little off the plane of double
+  roots, each root refined in arb): every sign it proves is the sign of D_e f there (170-bit central
+  differences), it never calls a piece holding a root rootless, and on the paper's manipulator it proves signs
+  that ``aligned_r_slopes`` alone does not (on the second design, none at these box sizes); with the D^2 term's
+  sign flipped, or |s| bounded by |D| V / 1000 instead of |D| sqrt(V), it fails;
 - ``aligned_r_slopes`` holds df/dr_l (arb, by a central difference at 170 bits) at sampled points of random
   boxes and pieces, near the zeros of D as well (a slope with the D^2 term dropped, or the factor 2 on s lost,
   fails);
@@ -25,8 +30,11 @@ from flint import arb, ctx, fmpq
 
 from intervalkin.kinematics.reduced_equation import HARMONICS, aligned_numerator
 from intervalkin.kinematics.sextic import laurent_value, reduction
+from intervalkin.core.interval import Interval
+from intervalkin.kinematics.reduced_equation import denominator
 from intervalkin.solve.window_split import (D_GAP, aligned_r_slopes, d_zeros, denominator_enclosure, gap_positive,
-                                          line_misses_circle)
+                                          line_misses_circle, root_direction_signs)
+from intervalkin.space.joint_retraction import DIRECTIONS
 
 
 def _q(v):
@@ -198,3 +206,79 @@ def test_denominator_enclosure_holds_and_signs_pieces_next_to_a_gap(which, paper
     for side in (left, right):
         assert np.all((side.hi < 0) | (side.lo > 0))
     assert np.all(np.sign(left.lo) * np.sign(right.lo) < 0)
+
+
+def _float_f_times_leg(geometry, r, phi):
+    """F = f |m_2|^2 = s^2 - D^2 V in floats at r and an array of phi: only to locate roots, refined in arb."""
+    aligned = aligned_numerator(geometry)
+    w = np.array([np.cos(k * phi) if t == 0 else np.sin(k * phi) for k, t in HARMONICS]).T
+    s = w @ aligned.coefficients.mid() @ np.r_[1.0, r]
+    leg = w @ aligned.leg_square.mid()
+    d = denominator(geometry).mid()
+    dd = d[0] + d[1] * np.cos(phi) + d[2] * np.sin(phi)
+    return s ** 2 - dd ** 2 * (r[0] * leg - (r[1] - r[0] - leg / 4) ** 2)
+
+
+def _arb_root(geometry, r, a, b):
+    """A root of f(.; r) in [a, b] (f changes sign there), to about 1e-30 by bisection in arb."""
+    fa = _arb_parts(geometry, r, a)[0]
+    for _ in range(100):
+        m = 0.5 * (a + b)
+        fm = _arb_parts(geometry, r, m)[0]
+        if (fm > 0) == (fa > 0):
+            a, fa = m, fm
+        else:
+            b = m
+    return 0.5 * (a + b)
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_root_direction_signs_hold_at_the_roots_beside_the_zeros_of_d(which, paper_geometry, second_geometry, rng):
+    geometry = paper_geometry if which == "paper" else second_geometry
+    lo_j, hi_j = float(max(geometry.rho_min)), float(min(geometry.rho_max))
+    zeros = d_zeros(geometry)
+    roots = proved = beyond = 0
+    with ctx.workprec(170):
+        for k in range(120):
+            phi_d = zeros[k % 2]
+            r = _plane_point(geometry, phi_d, rng.uniform(lo_j ** 2, hi_j ** 2, 2))
+            if not (lo_j ** 2 < r[0] < hi_j ** 2):
+                continue
+            width = 10 ** rng.uniform(-2.5, -1)
+            rho = np.sqrt(r) + width * rng.uniform(-1, 1, 3)
+            grid = phi_d + np.linspace(-0.1, 0.1, 4001)
+            values = _float_f_times_leg(geometry, rho ** 2, grid)
+            change = np.flatnonzero(np.sign(values[:-1]) != np.sign(values[1:]))
+            for i in change[:2]:
+                phi = _arb_root(geometry, rho ** 2, float(grid[i]), float(grid[i + 1]))
+                if abs(phi - phi_d) < 1e-6:
+                    continue  # D = 0 there: not a solution
+                roots += 1
+                box = np.stack([rho - rng.uniform(0, width), rho + rng.uniform(0, width)], axis=1)[None]
+                lo, hi = phi - 10 ** rng.uniform(-5, -2), phi + 10 ** rng.uniform(-5, -2)
+                one = np.zeros(1, dtype=np.int64)
+                signs, rootless = root_direction_signs(geometry, box, one, np.array([lo]), np.array([hi]), DIRECTIONS)
+                assert not rootless[0], "a piece holding a root of f called rootless"
+                slopes = aligned_r_slopes(geometry, box, one, np.array([lo]), np.array([hi]))
+                grad = []
+                for axis in range(3):
+                    step = np.zeros(3)
+                    step[axis] = 1e-6
+                    up = _arb_parts(geometry, rho ** 2 + step, phi)[0]
+                    down = _arb_parts(geometry, rho ** 2 - step, phi)[0]
+                    run = arb(float((rho ** 2 + step)[axis])) - arb(float((rho ** 2 - step)[axis]))
+                    grad.append(2 * rho[axis] * float(((up - down) / run).mid()))  # D_{e_l} = 2 rho_l d/dr_l
+                for c, e in enumerate(DIRECTIONS):
+                    if signs[0, c] == 0:
+                        continue
+                    proved += 1
+                    value = float(np.dot(e, grad))
+                    assert np.sign(value) == signs[0, c], (e, value, signs[0, c])
+                    # what the slopes over the whole piece could not sign
+                    old = [sl * Interval(2 * box[:, a, 0], 2 * box[:, a, 1]) * float(x)
+                           for a, (x, sl) in enumerate(zip(e, slopes))]
+                    total = old[0] + old[1] + old[2]
+                    beyond += bool(total.lo[0] <= 0 <= total.hi[0])
+    assert roots >= 40, roots
+    if which == "paper":  # on the second design |D| sqrt(V) stays far above what the s-term allows: no sign
+        assert proved >= roots and beyond >= 20, (roots, proved, beyond)

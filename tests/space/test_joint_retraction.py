@@ -234,3 +234,62 @@ def test_the_summary_reports_the_retraction(fold_paving, retraction):
     assert block["plane_sides"]["unresolved"] == (sided & (retraction.rank < 0)).sum()
     assert 0 < block["volume_unresolved"] <= fold_paving.paving.volume().sum()
     assert "retraction" not in fold_paving.open_places()
+
+
+def _window_count(geometry, point, lo: float, hi: float) -> int | None:
+    """The number of solutions at an exact point whose phi lies in [lo, hi] (mod 2 pi), by an independent certified
+    solve; None where it does not complete."""
+    res = solve(geometry, [Fraction(float(x)) for x in point])
+    if not res.complete or any(s.status != "unique" for s in res.solutions):
+        return None
+    phis = [float(np.mean(s.box[2])) for s in res.solutions]
+    return sum(any(lo <= p + k * 2 * np.pi <= hi for k in (-1, 0, 1)) for p in phis)
+
+
+def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_geometry):
+    """Property test of pair_direction_signs(at_roots=True) (proofs/lemma-joint-retraction.md, pattern nodes): where
+    it proves a direction the signs over whole pieces did not, or calls a window STEADY, the number of solutions in
+    the window (an independent certified solve) stays the same from a point of the box along e up to its boundary:
+    along e where the window is empty and its sign is +1 or it holds two roots and its sign is -1, along -e in the
+    other cases, either way where STEADY.  Signs over whole pieces are never changed, only added to."""
+    from intervalkin.solve.window_fold import STEADY, pair_direction_signs, pair_windows
+    from intervalkin.solve.window_plane import split_at_zeros_of_d
+    from intervalkin.solve.window_union import joined_windows
+    from intervalkin.space.joint_retraction import DIRECTIONS
+
+    win = fold_paving.windows
+    models = split_at_zeros_of_d(paper_geometry, joined_windows(win.models)).models
+    # a sample of the boxes with a pair window beside a zero of D, where the signs at the roots tell most
+    w_lo = np.full(len(models.degree), np.inf)
+    w_hi = np.full(len(models.degree), -np.inf)
+    np.minimum.at(w_lo, models.piece_window, models.piece_lo)
+    np.maximum.at(w_hi, models.piece_window, models.piece_hi)
+    gap = np.min([np.maximum(np.maximum(w_lo - z, z - w_hi), 0) for z in d_zeros(paper_geometry)], axis=0)
+    near = np.unique(models.window_box[pair_windows(models) & (gap < 0.1) & models.ok[models.window_box]])
+    rng = np.random.default_rng(17)
+    rows = np.sort(rng.choice(near, size=min(near.size, 2500), replace=False))
+    old, _ = pair_direction_signs(paper_geometry, models, rows, DIRECTIONS, at_roots=False)
+    new, _ = pair_direction_signs(paper_geometry, models, rows, DIRECTIONS, at_roots=True)
+    assert np.all((old == 0) | (new == old) | (new == STEADY))
+    gained = np.flatnonzero(pair_windows(models) & ((old == 0) & (new != 0)).any(axis=1))
+    assert gained.size >= 100
+    rng.shuffle(gained)
+    checked = steady = 0
+    for w in gained[:60]:
+        box = models.boxes[models.window_box[w]]
+        c = rng.choice(np.flatnonzero((old[w] == 0) & (new[w] != 0)))
+        x = box[:, 0] + rng.random(3) * (box[:, 1] - box[:, 0])
+        status = _window_count(paper_geometry, x, w_lo[w], w_hi[w])
+        if status is None:
+            continue
+        assert status in (0, 2)
+        way = 1 if new[w, c] == STEADY or (new[w, c] == 1) == (status == 0) else -1
+        e = way * DIRECTIONS[c].astype(float)
+        reach = min(np.min(np.where(e > 0, (box[:, 1] - x) / np.where(e > 0, e, 1), np.inf)),
+                    np.min(np.where(e < 0, (box[:, 0] - x) / np.where(e < 0, e, -1), np.inf)))
+        for t in (0.2, 0.4, 0.6, 0.8, 1.0):
+            got = _window_count(paper_geometry, np.clip(x + t * reach * e, box[:, 0], box[:, 1]), w_lo[w], w_hi[w])
+            assert got is None or got == status, (w, DIRECTIONS[c], way, t, status, got)
+        checked += 1
+        steady += bool(new[w, c] == STEADY)
+    assert checked >= 40, checked

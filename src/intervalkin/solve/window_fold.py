@@ -46,14 +46,16 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval, sign_label
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_count import window_signature
-from intervalkin.solve.window_split import aligned_r_slopes
+from intervalkin.solve.window_split import aligned_r_slopes, root_direction_signs
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced", "fold_piece",
-           "extreme_corners", "base_signature", "window_kinds", "pair_windows", "pair_slopes", "pair_direction_signs"]
+           "extreme_corners", "base_signature", "window_kinds", "pair_windows", "pair_slopes", "pair_direction_signs", "STEADY"]
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
+#: pair_direction_signs(at_roots=True) for a window whose status no point of the box changes: every direction keeps it.
+STEADY = 2
 #: What the two roots of a pair window add to a signature (count, n_wa1, n_wa2).
 PAIR = np.array([2, 1, 1], dtype=np.int64)
 #: Why a modelled box is neither window-clear nor a window fold, most telling first (:func:`why_not_pieced`):
@@ -239,12 +241,21 @@ def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: i
 
 
 def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndarray, directions: np.ndarray,
-                         halvings: int = CRITICAL_HALVINGS) -> tuple[np.ndarray, np.ndarray]:
+                         halvings: int = CRITICAL_HALVINGS, at_roots: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """For the pair windows of boxes ``rows`` and each direction e (c, 3) in rho: ((w, c) int8, the certified
     sign of s D_e f = s sum_l e_l 2 rho_l df/dr_l on the window's critical pieces over R, that is the direction
     in which u = min s f moves along e (0: not certified); (w,) bool, windows with no critical piece (u > 0 on
     the whole box)).  Other windows: 0 and False.  df/dr_l is the intersection of the Taylor form's enclosure
-    and :func:`~intervalkin.solve.window_split.aligned_r_slopes` (tighter near the zeros of D)."""
+    and :func:`~intervalkin.solve.window_split.aligned_r_slopes` (tighter near the zeros of D).
+
+    ``at_roots``: the sign only at the roots of f on the critical pieces, which is all the retraction needs (u
+    changes sign only through u = 0, where its minimum is a double root; proofs/lemma-joint-retraction.md): where
+    the whole-piece form gives none, the sign at the roots of
+    :func:`~intervalkin.solve.window_split.root_direction_signs`; critical pieces proved to hold no root (or whose
+    two forms disagree, which they could not at a root) then say nothing, and a window whose critical pieces all
+    hold none gets :data:`STEADY` for every direction (u does not vanish on the box, so its status is the same at
+    every point of it).  The window folds need the sign at every point of the critical pieces (u monotone), so
+    it is off for them."""
     w = len(models.degree)
     rows = np.asarray(rows, dtype=np.int64)
     directions = np.asarray(directions, dtype=np.float64)
@@ -264,15 +275,26 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     aligned = aligned_r_slopes(geometry, models.boxes[rows], owner, lo, hi)
     grad = [data.r_slope(owner, lo, hi, axis).intersect(aligned[axis])
             * Interval(2.0 * box[:, axis, 0], 2.0 * box[:, axis, 1]) for axis in range(3)]
-    free = even & (np.bincount(pw, minlength=w) == 0)
+    quiet = np.zeros(pw.size, dtype=bool)  # critical pieces proved to hold no root of f
+    root = np.zeros((pw.size, len(directions)), dtype=np.int8)
+    if at_roots:
+        root, quiet = root_direction_signs(geometry, models.boxes[rows], owner, lo, hi, directions)
+    signs = np.zeros((pw.size, len(directions)), dtype=np.int8)
     for c, e in enumerate(directions):
-        value = grad[0] * e[0] + grad[1] * e[1] + grad[2] * e[2]
-        sg = sign_label(value).astype(np.int64) * s[pw]
+        sg = sign_label(grad[0] * e[0] + grad[1] * e[1] + grad[2] * e[2]).astype(np.int8)
+        # both hold at any root of the piece: opposite proved signs prove it holds none
+        quiet |= (sg * root[:, c]) < 0
+        signs[:, c] = np.where(sg != 0, sg, root[:, c])
+    free = even & (np.bincount(pw, minlength=w) == 0)
+    for c in range(len(directions)):
+        sg = signs[:, c].astype(np.int64) * s[pw]
         low = np.full(w, 2, dtype=np.int64)
         high = np.full(w, -2, dtype=np.int64)
-        np.minimum.at(low, pw, sg)
-        np.maximum.at(high, pw, sg)
+        np.minimum.at(low, pw[~quiet], sg[~quiet])
+        np.maximum.at(high, pw[~quiet], sg[~quiet])
         out[:, c] = np.where(even & (low == high) & (np.abs(low) == 1), low, 0)
+    # no root on any critical piece: u never vanishes on the box, whichever its sign (either pattern keeps)
+    out[even & ~free & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
     return out, free
 
 

@@ -14,9 +14,10 @@ Two kinds of windows of :mod:`intervalkin.solve.window_model` are not certified 
   and is proved at the point.
 
 
-Two bounds read f through f |m_2|^2 = s^2 - D^2 V (proofs/lemma-line-misses-circle.md), where its terms do
+Three bounds read f through f |m_2|^2 = s^2 - D^2 V (proofs/lemma-line-misses-circle.md), where its terms do
 not cancel: :func:`line_misses_circle` settles pieces f > 0 where the line of legs 1 and 2 misses the circle of
-leg 1, and :func:`aligned_r_slopes` encloses df/dr_l near the zeros of D, where the Taylor form cannot sign it.
+leg 1, :func:`aligned_r_slopes` encloses df/dr_l near the zeros of D, where the Taylor form cannot sign it, and
+:func:`root_direction_signs` encloses it at the roots of f alone, where |s| = |D| sqrt(V).
 
 Everything here is vectorised over windows, pieces and brackets.
 """
@@ -31,7 +32,7 @@ from intervalkin.core.interval import PI_HI, Interval, certainly_negative, certa
 from intervalkin.kinematics.reduced_equation import aligned_numerator, denominator
 from intervalkin.solve.simple_roots import trig_basis
 
-__all__ = ["denominator_enclosure", "gap_positive", "line_misses_circle", "aligned_r_slopes", "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
+__all__ = ["denominator_enclosure", "gap_positive", "line_misses_circle", "aligned_r_slopes", "root_direction_signs", "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
 
 #: Half-width of the gap cut around each zero of D in a D-open window.
 D_GAP = 1e-9
@@ -106,15 +107,8 @@ def line_misses_circle(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray,
     return certainly_negative(v) & (sign_label(denominator_enclosure(geometry, lo, hi)) != 0)
 
 
-def aligned_r_slopes(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
-                     hi: np.ndarray) -> list[Interval]:
-    """Enclosures of df/dr_l, l = 1, 2, 3, over R^2 x [lo, hi], R = boxes[owner], from f L = s^2 - D^2 V
-    (:func:`line_misses_circle`): L and D do not depend on r, so
-
-        df/dr_l = (2 s ds/dr_l - D^2 dV/dr_l) / L,   dV/dr_1 = L + 2 k, dV/dr_2 = -2 k, dV/dr_3 = 0,
-
-    with k = r_2 - r_1 - L / 4.  Near a zero of D, where the roots of f are close to s = 0, the two terms of
-    f no longer cancel in this form: s is affine in r and enclosed tightly (proofs/lemma-line-misses-circle.md)."""
+def _aligned_terms(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Over R^2 x [lo, hi], R = boxes[owner]: (ds/dr_l (m, 3) balls, L, s, D, k_2, r_i) of f L = s^2 - D^2 V."""
     aligned = aligned_numerator(geometry)
     phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
     basis = trig_basis(phi)
@@ -126,20 +120,101 @@ def aligned_r_slopes(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, l
     s = coef[:, 0]
     for i in range(3):
         s = s + coef[:, 1 + i] * Ball.from_interval(r[i])
-    s = s.to_interval()
-    d2 = denominator_enclosure(geometry, lo, hi).sqr()
     k = r[1] - r[0] - leg * 0.25
+    return coef[:, 1:], leg, s.to_interval(), denominator_enclosure(geometry, lo, hi), k, r
+
+
+def aligned_r_slopes(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
+                     hi: np.ndarray) -> list[Interval]:
+    """Enclosures of df/dr_l, l = 1, 2, 3, over R^2 x [lo, hi], R = boxes[owner], from f L = s^2 - D^2 V
+    (:func:`line_misses_circle`): L and D do not depend on r, so
+
+        df/dr_l = (2 s ds/dr_l - D^2 dV/dr_l) / L,   dV/dr_1 = L + 2 k, dV/dr_2 = -2 k, dV/dr_3 = 0,
+
+    with k = r_2 - r_1 - L / 4.  Near a zero of D, where the roots of f are close to s = 0, the two terms of
+    f no longer cancel in this form: s is affine in r and enclosed tightly (proofs/lemma-line-misses-circle.md)."""
+    slopes, leg, s, d, k, _ = _aligned_terms(geometry, boxes, owner, lo, hi)
+    d2 = d.sqr()
     dv = [leg + k * 2.0, k * -2.0, None]
     positive = certainly_positive(leg)
     leg = Interval(np.where(positive, leg.lo, 1.0), np.where(positive, leg.hi, 1.0))
     out = []
     for i in range(3):
-        num = s * coef[:, 1 + i].to_interval() * 2.0
+        num = s * slopes[:, i].to_interval() * 2.0
         if dv[i] is not None:
             num = num - d2 * dv[i]
         slope = num / leg
         out.append(Interval(np.where(positive, slope.lo, -np.inf), np.where(positive, slope.hi, np.inf)))
     return out
+
+
+def _integer_combinations(lo: np.ndarray, hi: np.ndarray, e: np.ndarray) -> Interval:
+    """(m, c): enclosures of sum_l e_l x_l for x_l in [lo_l, hi_l] (m, k <= 3) and integer rows e (c, k) with
+    entries in -2..2, by two matrix products per end: a float sum of at most six exact products errs by at most
+    5 u times the sum of their magnitudes, and the margin taken is 2**-50 = 8 u times it
+    (proofs/lemma-line-misses-circle.md, Enclosures)."""
+    pos, neg = np.maximum(e, 0).T.astype(np.float64), np.minimum(e, 0).T.astype(np.float64)
+    with np.errstate(invalid="ignore"):
+        c_lo, c_hi = lo @ pos + hi @ neg, hi @ pos + lo @ neg
+        margin = (np.maximum(np.abs(lo), np.abs(hi)) @ np.abs(e).T.astype(np.float64)) * 2.0**-50 + 2.0**-1000
+        c_lo, c_hi = c_lo - margin, c_hi + margin
+    bad = ~(np.isfinite(c_lo) & np.isfinite(c_hi))
+    return Interval(np.where(bad, -np.inf, c_lo), np.where(bad, np.inf, c_hi))
+
+
+#: Pieces per block in :func:`root_direction_signs` (its arrays are pieces x directions).
+_ROOT_BLOCK = 16384
+
+
+def root_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
+                         hi: np.ndarray, directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """At the ROOTS of f only: ((m, c) int8, the sign of D_e f = sum_l e_l 2 rho_l df/dr_l at every root of f in
+    R^2 x [lo, hi], R = boxes[owner], for each integer direction e (c, 3) in rho, 0 where not proved; (m,) bool,
+    the pieces proved to hold no root of f).
+
+    At a root f L = s^2 - D^2 V = 0, so |s| = |D| sqrt(V) with V >= 0 (proofs/lemma-line-misses-circle.md,
+    statement 4): s lies in [-B, B], B = max |D| sqrt(max(V, 0)), and in its range over the piece; beside a zero
+    of D, where a root has s near 0 but the piece's range of s does not, the intersection is far narrower, and
+    where it is empty no point of the piece is a root.  Then L D_e f = 2 s D_e s - D^2 D_e V (statement 3), with
+    one s for every axis, and L > 0 where it is proved."""
+    directions = np.asarray(directions, dtype=np.int64)
+    if directions.size and np.abs(directions).max() > 2:
+        raise ValueError("root_direction_signs: direction entries must lie in -2..2 (their products are exact)")
+    m = len(owner)
+    signs = np.zeros((m, len(directions)), dtype=np.int8)
+    rootless = np.zeros(m, dtype=bool)
+    for a in range(0, m, _ROOT_BLOCK):
+        part = slice(a, min(a + _ROOT_BLOCK, m))
+        signs[part], rootless[part] = _root_block(geometry, boxes, owner[part], lo[part], hi[part], directions)
+    return signs, rootless
+
+
+def _root_block(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    slopes, leg, s, d, k, r = _aligned_terms(geometry, boxes, owner, lo, hi)
+    box = np.asarray(boxes, dtype=np.float64)[owner]
+    v = r[0] * leg - k.sqr()
+    bound = (Interval(np.zeros(len(owner)), np.maximum(v.hi, 0.0)).sqrt()
+             * Interval(np.zeros(len(owner)), np.maximum(np.abs(d.lo), np.abs(d.hi)))).hi
+    s_lo, s_hi = np.maximum(s.lo, -bound), np.minimum(s.hi, bound)
+    rootless = ~(s_lo <= s_hi)
+    signs = np.zeros((len(owner), len(directions)), dtype=np.int8)
+    # where the bound does not narrow s, this is aligned_r_slopes' enclosure again: not worth a second time
+    tight = np.flatnonzero(~rootless & (bound < np.maximum(np.abs(s.lo), np.abs(s.hi))))
+    if not tight.size:
+        return signs, rootless
+    slopes, leg, d, k, box = slopes[tight], leg[tight], d[tight], k[tight], box[tight]
+    at_root = Interval(s_lo[tight][:, None], s_hi[tight][:, None])
+    rho2 = [Interval(2.0 * box[:, i, 0], 2.0 * box[:, i, 1]) for i in range(3)]
+    ds = [slopes[:, i].to_interval() * rho2[i] for i in range(3)]
+    dv = [(leg + k * 2.0) * rho2[0], k * -2.0 * rho2[1]]
+    de_s = _integer_combinations(np.column_stack([x.lo for x in ds]), np.column_stack([x.hi for x in ds]), directions)
+    de_v = _integer_combinations(np.column_stack([x.lo for x in dv]), np.column_stack([x.hi for x in dv]),
+                                 directions[:, :2])
+    d2 = d.sqr()
+    value = at_root * de_s * 2.0 - Interval(d2.lo[:, None], d2.hi[:, None]) * de_v
+    signs[tight] = np.where(certainly_positive(leg)[:, None], sign_label(value), 0)
+    return signs, rootless
 
 
 def d_zeros(geometry: Geometry) -> np.ndarray:

@@ -23,10 +23,11 @@ of the node in it up to the face:
 * a node of a clear leaf: through every face (the signature is the same on the whole box);
 * the fold piece below: through the -e_k face; the piece above: through the +e_k face;
 * a pattern node: along a direction e of :data:`DIRECTIONS`, through the faces on the sides of e's nonzero
-  entries, when for each pair window i the sign of s D_e f over the window's critical pieces
-  (:func:`~intervalkin.solve.window_fold.pair_direction_signs`) is +1 where the window is empty (u_i = min s f
-  > 0 does not fall) and -1 where it holds two roots (u_i < 0 does not rise); the other roots are the same
-  on the whole box.
+  entries, when for each pair window i the sign of s D_e f at the roots of f on the window's critical pieces
+  (:func:`~intervalkin.solve.window_fold.pair_direction_signs` with ``at_roots``) is +1 where the window is
+  empty (u_i = min s f > 0 cannot reach 0) and -1 where it holds two roots (u_i < 0 cannot reach 0), or the
+  window is STEADY (no root on any critical piece: u_i keeps its sign on the whole box); the other roots are the
+  same on the whole box.
 
 RANKS (a fixed point): a node is resolved at rank r >= 1 when, for some face f it retracts through that is not
 on the border of the joint box, every leaf across f is modelled (no LEFT node of unknown signature) and
@@ -55,7 +56,7 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
-from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, base_signature, pair_direction_signs, pair_windows,
+from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, STEADY, base_signature, pair_direction_signs, pair_windows,
                                           window_kinds)
 from intervalkin.solve.window_model import DET_SIGN
 from intervalkin.solve.window_plane import split_at_zeros_of_d
@@ -320,7 +321,7 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
     nodes.add(win.leaf[fixed], base[fixed], RET, 2, -1, _EACH_FACE, plane=(split, fixed))
     rows = np.flatnonzero(open_rows & only_pairs & (n_pair >= 1))
     if rows.size:
-        signs, free = pair_direction_signs(geometry, models, rows, DIRECTIONS, halvings=PAIR_HALVINGS)
+        signs, free = pair_direction_signs(geometry, models, rows, DIRECTIONS, halvings=PAIR_HALVINGS, at_roots=True)
         # a free window (no critical piece: u > 0 on the whole box) never holds roots and keeps every direction,
         # so only the others make patterns
         live = pair & ~free
@@ -334,7 +335,7 @@ def _window_nodes(jp, geometry: Geometry, nodes: _Nodes) -> np.ndarray:
             for pattern in range(1 << k):
                 real = np.array([(pattern >> i) & 1 for i in range(k)], dtype=np.int64)
                 # u_i must not fall where window i is empty, not rise where it holds its two roots
-                keeps = (signs[wins] * (1 - 2 * real)[None, :, None] == 1).all(axis=1)
+                keeps = ((signs[wins] * (1 - 2 * real)[None, :, None] == 1) | (signs[wins] == STEADY)).all(axis=1)
                 at = _within_rolle(split, constant, wins, real)
                 nodes.add(win.leaf[rk[at]], base[rk[at]] + int(real.sum()) * PAIR, RET, 3, -1,
                           *_direction_options(keeps[at]), plane=(split, rk[at]))
