@@ -49,12 +49,13 @@ from intervalkin.solve.window_count import window_signature
 from intervalkin.solve.window_split import aligned_r_slopes, root_direction_signs
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
-__all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced", "fold_piece",
-           "extreme_corners", "base_signature", "window_kinds", "pair_windows", "pair_slopes", "pair_direction_signs", "STEADY"]
+__all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced",
+           "fold_piece", "extreme_corners", "base_signature", "window_kinds", "pair_windows", "pair_slopes",
+           "pair_direction_signs"]
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
-#: pair_direction_signs(at_roots=True) for a window whose status no point of the box changes: every direction keeps it.
+#: pair_direction_signs(at_roots=True) for a window whose status no point of the box changes (every direction keeps it).
 STEADY = 2
 #: What the two roots of a pair window add to a signature (count, n_wa1, n_wa2).
 PAIR = np.array([2, 1, 1], dtype=np.int64)
@@ -286,13 +287,13 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
         quiet |= (sg * root[:, c]) < 0
         signs[:, c] = np.where(sg != 0, sg, root[:, c])
     free = even & (np.bincount(pw, minlength=w) == 0)
-    for c in range(len(directions)):
-        sg = signs[:, c].astype(np.int64) * s[pw]
-        low = np.full(w, 2, dtype=np.int64)
-        high = np.full(w, -2, dtype=np.int64)
-        np.minimum.at(low, pw[~quiet], sg[~quiet])
-        np.maximum.at(high, pw[~quiet], sg[~quiet])
-        out[:, c] = np.where(even & (low == high) & (np.abs(low) == 1), low, 0)
+    # one sign per window and direction where all its pieces that may hold a root agree
+    sg = signs[~quiet].astype(np.int64) * s[pw[~quiet]][:, None]
+    low = np.full((w, len(directions)), 2, dtype=np.int64)
+    high = np.full((w, len(directions)), -2, dtype=np.int64)
+    np.minimum.at(low, pw[~quiet], sg)
+    np.maximum.at(high, pw[~quiet], sg)
+    out[:] = np.where(even[:, None] & (low == high) & (np.abs(low) == 1), low, 0)
     # no root on any critical piece: u never vanishes on the box, whichever its sign (either pattern keeps)
     out[even & ~free & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
     return out, free

@@ -32,7 +32,8 @@ from intervalkin.core.interval import PI_HI, Interval, certainly_negative, certa
 from intervalkin.kinematics.reduced_equation import aligned_numerator, denominator
 from intervalkin.solve.simple_roots import trig_basis
 
-__all__ = ["denominator_enclosure", "gap_positive", "line_misses_circle", "aligned_r_slopes", "root_direction_signs", "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
+__all__ = ["denominator_enclosure", "gap_positive", "line_misses_circle", "aligned_r_slopes", "root_direction_signs",
+           "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
 
 #: Half-width of the gap cut around each zero of D in a D-open window.
 D_GAP = 1e-9

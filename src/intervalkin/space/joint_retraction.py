@@ -56,8 +56,8 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
-from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, STEADY, base_signature, pair_direction_signs, pair_windows,
-                                          window_kinds)
+from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, STEADY, base_signature, pair_direction_signs,
+                                          pair_windows, window_kinds)
 from intervalkin.solve.window_model import DET_SIGN
 from intervalkin.solve.window_plane import split_at_zeros_of_d
 from intervalkin.solve.window_union import joined_windows
