@@ -34,7 +34,7 @@ from intervalkin.core.interval import Interval
 from intervalkin.kinematics.reduced_equation import denominator
 from intervalkin.solve.window_split import (D_GAP, aligned_r_slopes, d_zeros, denominator_enclosure, gap_positive,
                                           line_misses_circle, root_direction_signs)
-from intervalkin.space.joint_retraction import DIRECTIONS
+from intervalkin.space.retraction_nodes import DIRECTIONS
 
 
 def _q(v):

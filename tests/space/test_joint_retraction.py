@@ -255,7 +255,7 @@ def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_ge
     from intervalkin.solve.window_fold import STEADY, pair_direction_signs, pair_windows
     from intervalkin.solve.window_plane import split_at_zeros_of_d
     from intervalkin.solve.window_union import joined_windows
-    from intervalkin.space.joint_retraction import DIRECTIONS
+    from intervalkin.space.retraction_nodes import DIRECTIONS
 
     win = fold_paving.windows
     models = split_at_zeros_of_d(paper_geometry, joined_windows(win.models)).models

@@ -18,6 +18,8 @@ joint_separation        separations: cells of one signature proved to be differe
 joint_patterns          patterns: solutions per super-window of a window model; which two may meet on a face
 joint_pattern_nodes     window-modelled leaves as one node of G_sigma per possible pattern
 joint_refutation        contacts of G_sigma refuted by window models of both ends, on the shortest chains
+joint_retraction        the open layer retracted into the cells: the local step of an upper bound
+retraction_nodes, retraction_ranks   the retraction's nodes with their ways out; their ranks (a fixed point)
 characteristic_surface  aspect boxes certified off S_c
 pieces, sheets, voxel_paths   pieces of certified boxes and the sheet above a cell each lies on
 basic_region            basic regions and basic components (Theorem 1, Proposition 1)
