@@ -1,7 +1,7 @@
 """Benchmark of the direct joint-space paving (a script, not a test).
 
     python benchmarks/bench_joint_paving.py [--depths 6 7] [--geometry FILE] [--samples 2000] [--no-fold]
-        [--model-levels 1] [--face-levels 3] [--workers 1] [--windows] [--separations]
+        [--model-levels 1] [--face-levels 3] [--workers 1] [--windows] [--separations [--zones]]
 
 Per depth: boxes, wall time, peak memory (resident set of this process; and, sampled
 every 0.2 s, the largest sum over this process and its workers of the memory each holds
@@ -34,8 +34,9 @@ import psutil
 
 from intervalkin.core.geometry import default_geometry, load_geometry
 from intervalkin.solve.dkp import solve
-from intervalkin.space.joint_paving import DEFAULT_JOINT_DEPTH, joint_domain, pave_joint_space
+from intervalkin.space.joint_paving import DEFAULT_JOINT_DEPTH, JOIN_LEVELS, joint_domain, pave_joint_space
 from intervalkin.space.joint_separation import separated_cells
+from intervalkin.space.joint_topology import refine_separations
 
 
 class _MemoryWatch:
@@ -111,6 +112,8 @@ def main() -> None:
     ap.add_argument("--windows", action="store_true",
                     help="window models for the leaves with no fold model (as analyze and paper do)")
     ap.add_argument("--workers", type=int, default=None, help="processes (default: the library's, two on 2 cores)")
+    ap.add_argument("--zones", action="store_true",
+                    help="with --separations: pave again, finer between cells still joined (space.joint_topology)")
     ap.add_argument("--separations", action="store_true",
                     help="the separations of cells of one signature, and the basic regions they prove (with --windows)")
     args = ap.parse_args()
@@ -165,6 +168,14 @@ def main() -> None:
                 + f"; at least {sep.components_at_least()} components and {sep.basic_regions_at_least()} basic regions; "
                 f"{sep.pattern_nodes} pattern nodes, {sep.refuted_contacts} refuted contacts, "
                 f"{sep.leaves_modelled} leaves modelled", flush=True)
+            if args.zones and sep.between.size:
+                t1 = time.perf_counter()
+                jp, sep = refine_separations(g, jp, sep, depth, JOIN_LEVELS, fold=not args.no_fold, **extra)
+                print(f"       zone passes ({time.perf_counter() - t1:.1f} s, paving and separations again): "
+                      + "; ".join(f"{z['boxes']} boxes of the uniform level (volume {z['volume']:.2f}) split "
+                                  f"{z['levels']} more times: at least {z['components_at_least']} components, "
+                                  f"{'kept' if z['kept'] else 'not kept'}" for z in sep.zone_passes)
+                      + f"; at least {sep.basic_regions_at_least()} basic regions", flush=True)
         if first is None:
             first = jp
         else:

@@ -189,3 +189,24 @@ def test_open_places_are_reported_with_their_reasons(folder):
     assert ("Retraction towards the cells (proofs/lemma-joint-retraction.md): 30 of 40 nodes off the cells are ranked; "
             "7 leaves (volume 0.50) still hold a node that is not, so no upper bound: pair-window patterns 4, "
             "leaves without pieces 6.") in text
+
+
+def test_the_pavings_made_again_between_joined_cells_are_reported(folder):
+    """A separation block with zone passes says how often the joint box was paved again and which paving
+    stands; without passes nothing is said of them."""
+    from intervalkin.app.report_joint import joint_cells_passage
+
+    summary = json.loads(json.dumps(folder[1]))
+    sep = summary["joint_cells"]["separations"]
+    sep["by_signature"] = [{"signature": [4, 2, 2], "groups": [[1], [3]], "components_at_least": 2}]
+    limits = ([10.0] * 3, [32.0] * 3)
+    sep["zone_passes"] = []
+    assert "paved again" not in "\n".join(joint_cells_passage(summary, limits))
+    sep["zone_passes"] = [{"boxes": 14, "levels": 4, "volume": 0.53, "same_cells": True, "components_at_least": 10,
+                           "kept": True}]
+    text = "\n".join(joint_cells_passage(summary, limits))
+    assert ("The joint box was paved again 1 time, finer between cells still joined (14 boxes of the uniform level, "
+            "volume 0.53, split 4 more times); 1 of these pavings proved more cells apart and the last one kept is "
+            "the one reported.") in text
+    sep["zone_passes"][0]["kept"] = False
+    assert "none was kept: the first paving is the one reported" in "\n".join(joint_cells_passage(summary, limits))

@@ -13,6 +13,19 @@ __all__ = ["joint_cells_passage"]
 _FACE = 0.5  # a witness this close to a limit is said to lie "along" that face
 
 
+def _zone_text(sep: dict) -> str:
+    """The pavings made again between cells still joined (space.joint_topology), when any."""
+    passes = sep.get("zone_passes") or []
+    if not passes:
+        return ""
+    kept = sum(1 for z in passes if z["kept"])
+    last = passes[-1]
+    return (f"The joint box was paved again {len(passes)} time{'s' if len(passes) > 1 else ''}, finer between cells "
+            f"still joined ({last['boxes']} boxes of the uniform level, volume {last['volume']:.2f}, split "
+            f"{last['levels']} more times); {kept} of these pavings proved more cells apart and "
+            f"{'the last one kept is' if kept else 'none was kept: the first paving is'} the one reported. ")
+
+
 def _barrier_text(sep: dict) -> str:
     """Which separations the certificates hold (count barriers) and which they do not."""
     bars = sep.get("count_barriers")
@@ -87,7 +100,8 @@ def joint_cells_passage(summary: dict, limits: tuple[list[float], list[float]]) 
             for g in apart)
             + f". Cells in different groups are proved to be different components (proofs/lemma-separation.md): "
             f"at least {sep['components_at_least']} components hold a cell, and at least "
-            f"{sep['basic_regions_at_least']} basic regions lie above them. " + _barrier_text(sep) + "\n")
+            f"{sep['basic_regions_at_least']} basic regions lie above them. " + _zone_text(sep) + _barrier_text(sep)
+            + "\n")
     frags = jc.get("fragments") or []
     if frags:
         out.append(f"{len(frags)} fragment{'' if len(frags) == 1 else 's'} (certified islands inside the undecided layer, made only by the local "

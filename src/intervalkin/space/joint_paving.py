@@ -68,6 +68,7 @@ from intervalkin.space.joint_places import WHY_OPEN, open_leaves, open_places, p
 from intervalkin.space.joint_window_pieces import (check_window_cells, signatures_from_windows, window_cell_of,
                                                    window_columns, window_pieces)
 from intervalkin.space.joint_windows import JointWindows, window_refinement
+from intervalkin.space.joint_zones import RefinementZone
 
 __all__ = ["JointSpaceCell", "JointSpacePaving", "pave_joint_space", "joint_domain", "DEFAULT_JOINT_DEPTH", "JOIN_LEVELS", "MODEL_LEVELS"]
 
@@ -272,7 +273,8 @@ def joint_domain(geometry: Geometry) -> np.ndarray:
 def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_levels: int = JOIN_LEVELS,
                      progress: Callable[[dict], None] | None = None, fold: bool = True,
                      face_levels: int = FACE_LEVELS, model_levels: int = MODEL_LEVELS,
-                     windows: bool = False, workers: int | None = None) -> JointSpacePaving:
+                     windows: bool = False, workers: int | None = None,
+                     zone: RefinementZone | None = None) -> JointSpacePaving:
     """Pave the joint box to ``depth`` with the clear-box test, join cells across walls, and count them.
 
     Parameters
@@ -297,6 +299,8 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     workers : processes (default: two on a machine with two cores or more, see
         :func:`intervalkin.core.workers.default_workers`); large steps are cut into parts
         computed at once, and the paving is the same bit for bit whatever the number.
+    zone : undecided leaves inside its boxes are split ``zone.levels`` more times after the face levels
+        (:mod:`intervalkin.space.joint_zones`: where the separations found two cells joined).
 
     Cost: the undecided boxes lie along the 2-D surface g(S), so their number grows
     like 4**depth; each cell costs one certified solve.
@@ -305,17 +309,19 @@ def pave_joint_space(geometry: Geometry, depth: int = DEFAULT_JOINT_DEPTH, join_
     for name, v in (("join_levels", join_levels), ("face_levels", face_levels), ("model_levels", model_levels)):
         if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 8:
             raise InputError(f"{name}: expected an integer in 0..8, got {v!r}")
+    if zone is not None and zone.depth != depth:
+        raise InputError(f"zone: its boxes are of level {zone.depth}, the paving's uniform level is {depth}")
     count = default_workers() if workers is None else workers
     if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= 64:
         raise InputError(f"workers: expected an integer in 1..64, got {workers!r}")
     with Workers(count) as pool, one_blas_thread():
         if depth >= DEFAULT_JOINT_DEPTH:  # large enough to use them: started while this process is small
             pool.start()
-        return _pave(geometry, depth, join_levels, progress, fold, face_levels, model_levels, windows, pool)
+        return _pave(geometry, depth, join_levels, progress, fold, face_levels, model_levels, windows, pool, zone)
 
 
 def _pave(geometry: Geometry, depth: int, join_levels: int, progress, fold: bool, face_levels: int,
-          model_levels: int, windows: bool, pool: Workers) -> JointSpacePaving:
+          model_levels: int, windows: bool, pool: Workers, zone=None) -> JointSpacePaving:
     domain = joint_domain(geometry)
     found_leaves, stats = adaptive_leaves(geometry, domain, depth, progress, pool)
     leaves = found_leaves.merge()
@@ -337,6 +343,12 @@ def _pave(geometry: Geometry, depth: int, join_levels: int, progress, fold: bool
             break
         leaves = timed_step(progress, stats, store, "faces", depth + extra + 1,
                         lambda: settle(refine_leaves(geometry, domain, leaves, wall, pool)), leaves, wall)
+    for _ in range(zone.levels if zone is not None else 0):  # where the separations asked for finer leaves
+        wall = ~leaves[4] & zone.holds(leaves[0], leaves[1])
+        if not np.any(wall):
+            break
+        leaves = timed_step(progress, stats, store, "zone", int(leaves[0][wall].max()) + 1,
+                            lambda: settle(refine_leaves(geometry, domain, leaves, wall, pool)), leaves, wall)
     fine = top = int(leaves[0].max())
     cells = CellSolver(geometry)
 

@@ -32,12 +32,14 @@ certificates.  Where a *count barrier* exists (a region around a cell whose boun
 point of its count, :mod:`intervalkin.certify.separation_claims`), the separation is also written
 to ``certificates/joint_separation.json`` and re-proved by ``intervalkin verify``; the others
 (cells told apart only by the patterns of window models) are re-proved by nothing yet, and the
-printed certified lower bounds use none of them.
+printed certified lower bounds use none of them.  Where two cells stay in one group, the leaves on the
+near-shortest chains between them (:attr:`Separation.between`) say where a finer paving may cut the chains
+(:mod:`intervalkin.space.joint_zones`): a choice of effort, not part of any proof.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -49,6 +51,7 @@ from intervalkin.solve.window_fold import CLEAR, FOLD
 from intervalkin.space.joint_closure import decided_traces, piece_cells
 from intervalkin.space.joint_pattern_nodes import PatternNodes, expand
 from intervalkin.space.joint_refutation import Refuter, near_shortest
+from intervalkin.space.joint_zones import leaves_between
 
 __all__ = ["Separation", "separated_cells", "leaf_signatures", "possible_counts"]
 
@@ -59,6 +62,9 @@ NO_PIECE, UNKNOWN = -2, -1
 ANY = -1
 #: Rounds of window models on the shortest chains joining two cells of one signature (joint_refutation).
 REFUTE_ROUNDS = 24
+#: The leaves BETWEEN two cells still joined: those on chains of G_sigma at most this many contacts longer than
+#: the shortest (where a finer paving may cut them, :mod:`intervalkin.space.joint_zones`).
+BETWEEN_SLACK = 2
 
 
 @dataclass(frozen=True)
@@ -75,6 +81,9 @@ class Separation:
     refuted_contacts: int = 0
     leaves_modelled: int = 0
     rounds: int = 0
+    between: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64), compare=False)
+    #: the pavings made again with finer zones (space.joint_topology), one dict each: what they proved, kept or not
+    zone_passes: tuple = ()
 
     def components_at_least(self) -> int:
         """A proved lower bound on the number of components of the joint box minus g(S) that hold a cell."""
@@ -94,6 +103,8 @@ class Separation:
                 "refuted_contacts": self.refuted_contacts,
                 "leaves_modelled_for_refutation": self.leaves_modelled,
                 "refutation_rounds": self.rounds,
+                "leaves_between_joined_cells": int(self.between.size),
+                "zone_passes": [dict(p) for p in self.zone_passes],
                 "certified": "cells in different groups of one signature are different components of the joint "
                              "box minus g(S): no chain of face contacts between leaves (or patterns of window-"
                              "modelled leaves) that may hold that signature joins them (proofs/lemma-separation.md, "
@@ -213,6 +224,7 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
     size = g.n + len(g.pat.count)
     fragment = {c.id for c in jp.fragments}
     refuted = used = 0
+    between: list[np.ndarray] = []
     for s in sorted({c.signature for c in g.every if c.signature[0] >= 0}):  # a fragment may have no solve
         mine = [c for c in g.every if c.signature == s]
         all_src, all_dst = g.edges(s)
@@ -250,7 +262,10 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
         groups[s] = tuple(tuple(sorted(cs)) for cs in sorted(by_comp.values()))
         refuted += int(cut.sum())
         used = max(used, round_)
-    return Separation(groups, len(g.pat.count), refuted, refuter.modelled, used)
+        between.extend(leaves_between(size, all_src[~cut], all_dst[~cut], [g.leaves_of[c] for c in cs], g.n,
+                                      g.pat.leaf, BETWEEN_SLACK) for cs in merged)
+    between = np.unique(np.concatenate(between)) if between else np.zeros(0, dtype=np.int64)
+    return Separation(groups, len(g.pat.count), refuted, refuter.modelled, used, between)
 
 
 class _Graph:
