@@ -202,11 +202,12 @@ def test_the_pavings_made_again_between_joined_cells_are_reported(folder):
     limits = ([10.0] * 3, [32.0] * 3)
     sep["zone_passes"] = []
     assert "paved again" not in "\n".join(joint_cells_passage(summary, limits))
-    sep["zone_passes"] = [{"boxes": 14, "levels": 4, "volume": 0.53, "same_cells": True, "components_at_least": 10,
+    sep["zone_passes"] = [{"boxes": 14, "levels": 4, "volume": 0.53, "cells_found": 10, "old_cells_kept": True,
+                           "components_at_least": 10, "basic_regions_at_least": 28,
                            "kept": True}]
     text = "\n".join(joint_cells_passage(summary, limits))
     assert ("The joint box was paved again 1 time, finer between cells still joined (14 boxes of the uniform level, "
-            "volume 0.53, split 4 more times); 1 of these pavings proved more cells apart and the last one kept is "
-            "the one reported.") in text
+            "volume 0.53, split 4 more times); 1 of these pavings kept every cell and proved more apart, and the last "
+            "one kept (10 cells) is the one reported.") in text
     sep["zone_passes"][0]["kept"] = False
     assert "none was kept: the first paving is the one reported" in "\n".join(joint_cells_passage(summary, limits))

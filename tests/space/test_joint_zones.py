@@ -5,6 +5,7 @@
 - a paving with a zone (no join levels, which follow the cells): inside it the undecided leaves are finer,
   outside it the leaves are those of the paving without it; sampled points of the zone's clear leaves have
   the count of their cell (certified solver);
+- a finer paving is kept only when it loses or merges no cell and proves more components apart;
 - the leaves between two cells of one group hold a chain of face contacts from the one to the other
   (the shortest chains lie in them), and nothing is between when every group holds one cell.
 """
@@ -112,15 +113,20 @@ def test_the_leaves_between_two_joined_cells_hold_a_chain_from_one_to_the_other(
         assert np.intersect1d(comp[ends[0]], comp[ends[1]]).size, (first, second)
 
 
-def test_same_cells_match_by_witness_and_signature(paper_geometry, plain):
+def test_old_cells_are_kept_by_witness_and_signature(paper_geometry, plain):
     import dataclasses
 
-    from intervalkin.space.joint_topology import _same_cells
+    from intervalkin.space.joint_topology import _old_cells_kept
 
-    assert _same_cells(paper_geometry, plain, plain)
+    assert _old_cells_kept(paper_geometry, plain, plain)
     other = dataclasses.replace(plain.cells[0], count=plain.cells[0].count + 2)
-    assert not _same_cells(paper_geometry, plain, dataclasses.replace(plain, cells=(other,) + plain.cells[1:]))
-    assert not _same_cells(paper_geometry, plain, dataclasses.replace(plain, cells=plain.cells[:-1]))
+    assert not _old_cells_kept(paper_geometry, plain, dataclasses.replace(plain, cells=(other,) + plain.cells[1:]))
+    assert not _old_cells_kept(paper_geometry, plain, dataclasses.replace(plain, cells=plain.cells[:-1]))
+    # a cell found only by the finer paving loses none of the old ones
+    assert _old_cells_kept(paper_geometry, dataclasses.replace(plain, cells=plain.cells[:-1]), plain)
+    # two old cells whose witnesses fall in one new cell were merged
+    merged = np.where(plain.cell == 1, 0, plain.cell)
+    assert not _old_cells_kept(paper_geometry, plain, dataclasses.replace(plain, cell=merged))
 
 
 class _Fake:
@@ -137,7 +143,7 @@ class _Fake:
 
 
 @pytest.mark.parametrize("same, proves_more, kept", [(True, True, True), (True, False, False), (False, True, False)])
-def test_a_finer_paving_is_kept_only_with_the_same_cells_and_more_proved(monkeypatch, same, proves_more, kept):
+def test_a_finer_paving_is_kept_only_when_it_keeps_the_cells_and_proves_more(monkeypatch, same, proves_more, kept):
     import intervalkin.space.joint_topology as jt
 
     first = _Fake({(4, 2, 2): ((1, 3),)}, between=[0, 1])
@@ -145,7 +151,7 @@ def test_a_finer_paving_is_kept_only_with_the_same_cells_and_more_proved(monkeyp
     zones = []
     monkeypatch.setattr(jt, "pave_joint_space", lambda *a, zone=None, **k: zones.append(zone) or finer)
     monkeypatch.setattr(jt, "separated_cells", lambda jp, g: jp.separation)
-    monkeypatch.setattr(jt, "_same_cells", lambda g, a, b: same)
+    monkeypatch.setattr(jt, "_old_cells_kept", lambda g, a, b: same)
     cells, sep = jt.refine_separations(None, first, first.separation, DEPTH, 0)
     assert (cells is finer) == kept and len(sep.zone_passes) == 1 and sep.zone_passes[0]["kept"] == kept
     assert zones[0].depth == DEPTH and zones[0].levels == jt.ZONE_LEVELS and len(zones[0].cells) == 1

@@ -18,12 +18,14 @@ def _zone_text(sep: dict) -> str:
     passes = sep.get("zone_passes") or []
     if not passes:
         return ""
-    kept = sum(1 for z in passes if z["kept"])
+    kept = [z for z in passes if z["kept"]]
     last = passes[-1]
+    stands = (f"the last one kept ({kept[-1]['cells_found']} cells) is the one reported" if kept
+              else "none was kept: the first paving is the one reported")
     return (f"The joint box was paved again {len(passes)} time{'s' if len(passes) > 1 else ''}, finer between cells "
             f"still joined ({last['boxes']} boxes of the uniform level, volume {last['volume']:.2f}, split "
-            f"{last['levels']} more times); {kept} of these pavings proved more cells apart and "
-            f"{'the last one kept is' if kept else 'none was kept: the first paving is'} the one reported. ")
+            f"{last['levels']} more times); {len(kept)} of these pavings kept every cell and proved more apart, and "
+            f"{stands}. ")
 
 
 def _barrier_text(sep: dict) -> str:

@@ -11,9 +11,10 @@ process, beside the regions, rather than after both.  Nothing here is written to
 Where the separations leave two cells of one signature in one group, the joint box is paved again with the
 leaves between them (:attr:`~intervalkin.space.joint_separation.Separation.between`, as level-``depth`` boxes)
 split :data:`ZONE_LEVELS` more times (:mod:`intervalkin.space.joint_zones`), up to :data:`ZONE_PASSES` times, the
-zone growing by the leaves still between.  A finer paving is kept only when it finds the same cells (as many,
-each old cell's witness in a different new cell of its signature) and proves more of them apart; otherwise the
-one before it stands (a count found that moves with the paving is not yet a result).  On the paper's
+zone growing by the leaves still between.  A finer paving is kept only when it keeps every cell (each old
+cell's witness in a different new cell of its signature; it may find more) and proves more components apart;
+otherwise the one before it stands.  A cell found only by the finer paving changes the count found: the pass
+says so (``cells_found``), since a count that moves with the paving is not yet a result.  On the paper's
 manipulator with limits [10.5, 32] one pass proves cells 3 and 7 apart (a 6-solution sliver 0.016 wide keeps
 them apart along the face rho_3 = 10.5), so all 28 regions found are proved different; with the default limits
 every cell is apart already and no pass runs.
@@ -65,19 +66,22 @@ def refine_separations(geometry: Geometry, cells: JointSpacePaving, separation: 
         zone = more if zone is None else zone.union(more)
         finer = pave_joint_space(geometry, depth, join_levels, progress=progress, zone=zone, **levels)
         finer_separation = separated_cells(finer, geometry)
-        same = _same_cells(geometry, cells, finer)
+        kept_cells = _old_cells_kept(geometry, cells, finer)
         better = finer_separation.components_at_least() > separation.components_at_least()
-        passes.append({**zone.to_json(p.hi.max(axis=0) - p.lo.min(axis=0)), "same_cells": same,
-                       "components_at_least": finer_separation.components_at_least(), "kept": same and better})
-        if not (same and better):
+        passes.append({**zone.to_json(p.hi.max(axis=0) - p.lo.min(axis=0)), "cells_found": len(finer.cells),
+                       "old_cells_kept": kept_cells, "components_at_least": finer_separation.components_at_least(),
+                       "basic_regions_at_least": finer_separation.basic_regions_at_least(),
+                       "kept": kept_cells and better})
+        if not (kept_cells and better):
             break
         cells, separation = finer, finer_separation
     return cells, (dataclasses.replace(separation, zone_passes=tuple(passes)) if passes else separation)
 
 
-def _same_cells(geometry: Geometry, old: JointSpacePaving, new: JointSpacePaving) -> bool:
-    """As many cells, and the witnesses of the old ones in distinct new cells of their signatures."""
-    if len(old.cells) != len(new.cells):
+def _old_cells_kept(geometry: Geometry, old: JointSpacePaving, new: JointSpacePaving) -> bool:
+    """Every old cell's witness lies in a new cell of its signature, no two in one: no cell was lost or merged
+    (a finer paving may find more, as it may prove more of them apart)."""
+    if len(new.cells) < len(old.cells):
         return False
     witness = np.array([[float(v) for v in c.witness] for c in old.cells]).reshape(-1, 3)
     at = new.cell_of(witness, geometry)
