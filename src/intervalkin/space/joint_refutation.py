@@ -30,7 +30,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.solve.window_model import WindowModels, window_models
 from intervalkin.space.joint_patterns import EVERY, NONE, exclusive, pattern_at, row_of, window_patterns
 
-__all__ = ["Refuter", "near_shortest", "SLACK", "BATCH"]
+__all__ = ["Refuter", "near_shortest", "nodes_between", "SLACK", "BATCH"]
 
 #: Chains tried: up to this many contacts longer than the shortest.
 SLACK = 2
@@ -193,13 +193,7 @@ def near_shortest(n: int, src: np.ndarray, dst: np.ndarray, start: np.ndarray, g
     """Indices into the candidate contacts (a, b) lying on a chain of the graph (src, dst) on n nodes
     from a node of ``start`` to a node of ``goal`` at most :data:`SLACK` longer than the shortest,
     shortest first, at most :data:`BATCH`; empty when no chain joins them."""
-    hub = n  # one extra node next to every start (or goal) node: one breadth-first search each
-    dist = []
-    for ends in (start, goal):
-        graph = coo_matrix((np.ones(src.size + ends.size), (np.r_[src, np.full(ends.size, hub)], np.r_[dst, ends])),
-                           shape=(n + 1, n + 1))
-        dist.append(shortest_path(graph, directed=False, unweighted=True, indices=hub)[:n] - 1)
-    d0, d1 = dist
+    d0, d1 = _distances(n, src, dst, start), _distances(n, src, dst, goal)
     through = np.minimum(d0[a] + 1 + d1[b], d0[b] + 1 + d1[a])
     finite = np.isfinite(through)
     if not finite.any():
@@ -207,3 +201,21 @@ def near_shortest(n: int, src: np.ndarray, dst: np.ndarray, start: np.ndarray, g
     best = through[finite].min()
     pick = np.flatnonzero(finite & (through <= best + SLACK))
     return pick[np.argsort(through[pick], kind="stable")][:BATCH]
+
+
+def nodes_between(n: int, src: np.ndarray, dst: np.ndarray, start: np.ndarray, goal: np.ndarray,
+                  slack: int) -> np.ndarray:
+    """The nodes on chains of the graph (src, dst) on n nodes from ``start`` to ``goal`` at most ``slack`` edges
+    longer than the shortest (d(start, v) + d(v, goal) within slack of its least); empty when none joins them."""
+    total = _distances(n, src, dst, start) + _distances(n, src, dst, goal)
+    if not np.isfinite(total).any():
+        return np.zeros(0, dtype=np.int64)
+    return np.flatnonzero(total <= total.min() + slack)
+
+
+def _distances(n: int, src: np.ndarray, dst: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """(n,) the number of edges from the nearest node of ``ends`` (inf where none leads)."""
+    hub = n  # one extra node next to every end node: one breadth-first search
+    graph = coo_matrix((np.ones(src.size + ends.size), (np.r_[src, np.full(ends.size, hub)], np.r_[dst, ends])),
+                       shape=(n + 1, n + 1))
+    return shortest_path(graph, directed=False, unweighted=True, indices=hub)[:n] - 1

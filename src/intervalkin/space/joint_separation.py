@@ -50,8 +50,7 @@ from intervalkin.paving.adjacency import shares_face
 from intervalkin.solve.window_fold import CLEAR, FOLD
 from intervalkin.space.joint_closure import decided_traces, piece_cells
 from intervalkin.space.joint_pattern_nodes import PatternNodes, expand
-from intervalkin.space.joint_refutation import Refuter, near_shortest
-from intervalkin.space.joint_zones import leaves_between
+from intervalkin.space.joint_refutation import Refuter, near_shortest, nodes_between
 
 __all__ = ["Separation", "separated_cells", "leaf_signatures", "possible_counts"]
 
@@ -262,8 +261,10 @@ def separated_cells(jp, geometry: Geometry, rounds: int = REFUTE_ROUNDS) -> Sepa
         groups[s] = tuple(tuple(sorted(cs)) for cs in sorted(by_comp.values()))
         refuted += int(cut.sum())
         used = max(used, round_)
-        between.extend(leaves_between(size, all_src[~cut], all_dst[~cut], [g.leaves_of[c] for c in cs], g.n,
-                                      g.pat.leaf, BETWEEN_SLACK) for cs in merged)
+        for cs in merged:  # from the group's first cell to each other one; a pattern node stands for its leaf
+            for c in cs[1:]:
+                v = nodes_between(size, all_src[~cut], all_dst[~cut], g.leaves_of[cs[0]], g.leaves_of[c], BETWEEN_SLACK)
+                between.append(np.r_[v[v < g.n], g.pat.leaf[v[v >= g.n] - g.n]])
     between = np.unique(np.concatenate(between)) if between else np.zeros(0, dtype=np.int64)
     return Separation(groups, len(g.pat.count), refuted, refuter.modelled, used, between)
 

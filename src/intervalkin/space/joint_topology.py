@@ -37,7 +37,7 @@ __all__ = ["pave_joint_topology", "refine_separations", "ZONE_PASSES", "ZONE_LEV
 
 #: Pavings made again with a finer zone between cells still joined (each costs about one paving and its separations).
 ZONE_PASSES = 2
-#: Levels the zone's undecided leaves are split past those the paving gave them (up to 4 ** 4 leaves for one along a sheet).
+#: Levels the zone's undecided leaves are split past those the paving gave them (about 4 ** 4 children for one along a sheet).
 ZONE_LEVELS = 4
 
 

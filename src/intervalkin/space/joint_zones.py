@@ -19,14 +19,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import dijkstra
 
 from intervalkin.core.errors import InputError
 
-__all__ = ["RefinementZone", "MAX_ZONE_LEVELS", "leaves_between"]
+__all__ = ["RefinementZone", "MAX_ZONE_LEVELS"]
 
-#: Levels a zone may add to its leaves (16**levels more leaves along a sheet of g(S) at worst).
+#: Levels a zone may add to its leaves (about 4**levels undecided children for a leaf along a sheet of g(S)).
 MAX_ZONE_LEVELS = 6
 
 
@@ -76,20 +74,3 @@ class RefinementZone:
         return {"boxes": int(len(self.cells)), "levels": self.levels,
                 "volume": float(len(self.cells) * np.prod(np.asarray(span, dtype=float) / (1 << self.depth)))}
 
-
-def leaves_between(size: int, src: np.ndarray, dst: np.ndarray, cells: list[np.ndarray], n: int,
-                   pattern_leaf: np.ndarray, slack: int) -> np.ndarray:
-    """The leaves on chains of a graph from the first cell's leaves to each other cell's at most ``slack`` edges
-    longer than the shortest (a node v with d(first, v) + d(v, other) <= d(first, other) + slack).
-
-    ``size`` nodes, edges (src, dst); nodes below ``n`` are leaves, node n + k stands for leaf pattern_leaf[k]
-    (a pattern node of G_sigma).  ``cells``: the leaf arrays of cells joined in the graph.
-    """
-    graph = coo_matrix((np.ones(src.size), (src, dst)), shape=(size, size)).tocsr()
-    first = dijkstra(graph, directed=False, unweighted=True, indices=cells[0], min_only=True)
-    out = [np.zeros(0, dtype=np.int64)]
-    for other in cells[1:]:
-        total = first + dijkstra(graph, directed=False, unweighted=True, indices=other, min_only=True)
-        near = np.flatnonzero(total <= total.min() + slack)
-        out.append(np.r_[near[near < n], pattern_leaf[near[near >= n] - n]])
-    return np.unique(np.concatenate(out))
