@@ -293,3 +293,28 @@ def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_ge
         checked += 1
         steady += bool(new[w, c] == STEADY)
     assert checked >= 40, checked
+
+
+def test_the_direction_signs_split_between_processes_are_the_serial_ones(fold_paving, paper_geometry, monkeypatch):
+    """pair_direction_signs cut into parts for two processes returns exactly the serial arrays (each part runs on its
+    boxes' models alone, and the windows are put back where take() found them).  Rows are given unsorted and with a
+    box twice, as a caller may."""
+    from intervalkin.core.workers import Workers
+    from intervalkin.solve import window_fold
+    from intervalkin.solve.window_fold import pair_direction_signs, pair_windows
+    from intervalkin.solve.window_plane import split_at_zeros_of_d
+    from intervalkin.solve.window_union import joined_windows
+    from intervalkin.space.retraction_nodes import DIRECTIONS
+
+    models = split_at_zeros_of_d(paper_geometry, joined_windows(fold_paving.windows.models)).models
+    boxes = np.unique(models.window_box[pair_windows(models) & models.ok[models.window_box]])
+    rng = np.random.default_rng(5)
+    rows = rng.choice(boxes, size=min(boxes.size, 300), replace=False)
+    rows = np.r_[rows, rows[:1]]
+    serial = pair_direction_signs(paper_geometry, models, rows, DIRECTIONS, at_roots=True)
+    monkeypatch.setattr(window_fold, "MIN_PARALLEL_BOXES", 40)
+    with Workers(2) as workers:
+        parts = pair_direction_signs(paper_geometry, models, rows, DIRECTIONS, at_roots=True, workers=workers)
+    assert (serial[0] != 0).sum() > 100  # signs were proved, so a misplaced window would show
+    for a, b in zip(serial, parts):
+        assert a.dtype == b.dtype and np.array_equal(a, b)

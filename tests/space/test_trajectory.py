@@ -281,8 +281,9 @@ def test_json_object_and_outputs(paths, paper_geometry, chain, tmp_path):
 
 
 def test_the_box_path_is_a_shortest_one(paper_geometry, chain, solutions):
-    """The A* search between two of Table 1's solutions returns a chain of face-adjacent boxes of the aspect
-    whose length (centre to centre, the search's metric) is the one scipy's Dijkstra finds for the same graph."""
+    """The search between two of Table 1's solutions returns a chain of face-adjacent boxes of the aspect whose
+    length (centre to centre, the search's metric) is the one scipy's Dijkstra finds for a graph built here
+    (the path is read back from predecessors: a wrong step breaks the chain or lengthens it)."""
     from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import dijkstra
 

@@ -44,6 +44,7 @@ import numpy as np
 from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval, sign_label
+from intervalkin.core.workers import Workers
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_count import window_signature
 from intervalkin.solve.window_split import aligned_r_slopes, root_direction_signs
@@ -55,6 +56,8 @@ __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", 
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
+#: Boxes from which pair_direction_signs splits its work between processes, and parts per process.
+MIN_PARALLEL_BOXES, PARTS_PER_WORKER = 400, 4
 #: pair_direction_signs(at_roots=True) for a window whose status no point of the box changes (every direction keeps it).
 STEADY = 2
 #: What the two roots of a pair window add to a signature (count, n_wa1, n_wa2).
@@ -242,7 +245,8 @@ def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: i
 
 
 def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndarray, directions: np.ndarray,
-                         halvings: int = CRITICAL_HALVINGS, at_roots: bool = False) -> tuple[np.ndarray, np.ndarray]:
+                         halvings: int = CRITICAL_HALVINGS, at_roots: bool = False,
+                         workers: Workers | None = None) -> tuple[np.ndarray, np.ndarray]:
     """For the pair windows of boxes ``rows`` and each direction e (c, 3) in rho: ((w, c) int8, the certified
     sign of s D_e f = s sum_l e_l 2 rho_l df/dr_l on the window's critical pieces over R, that is the direction
     in which u = min s f moves along e (0: not certified); (w,) bool, windows with no critical piece (u > 0 on
@@ -256,10 +260,15 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     two forms disagree, which they could not at a root) then say nothing, and a window whose critical pieces all
     hold none gets :data:`STEADY` for every direction (u does not vanish on the box, so its status is the same at
     every point of it).  The window folds need the sign at every point of the critical pieces (u monotone), so
-    it is off for them."""
+    it is off for them.
+
+    ``workers``: boxes are cut into parts computed at once (each window's signs come from its own box alone, so
+    the arrays are the same bit for bit)."""
     w = len(models.degree)
     rows = np.asarray(rows, dtype=np.int64)
     directions = np.asarray(directions, dtype=np.float64)
+    if workers is not None and workers.count > 1 and rows.size >= MIN_PARALLEL_BOXES:
+        return _pair_direction_parts(geometry, models, rows, directions, halvings, at_roots, workers)
     out = np.zeros((w, len(directions)), dtype=np.int8)
     even = pair_windows(models) & np.isin(models.window_box, rows)
     if not even.any():
@@ -297,6 +306,29 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     # no root on any critical piece: u never vanishes on the box, whichever its sign (either pattern keeps)
     out[even & ~free & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
     return out, free
+
+
+def _pair_direction_parts(geometry: Geometry, models: WindowModels, rows: np.ndarray, directions: np.ndarray,
+                          halvings: int, at_roots: bool, workers: Workers) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`pair_direction_signs` with the boxes ``rows`` cut into parts, one call each on their models alone."""
+    rows = np.unique(rows)  # take() wants increasing rows; every window is then in exactly one part
+    k = min(rows.size // (MIN_PARALLEL_BOXES // 2), PARTS_PER_WORKER * workers.count)
+    cuts = [rows.size * i // k for i in range(k + 1)]
+    parts = [rows[cuts[i]:cuts[i + 1]] for i in range(k)]
+    got = workers.run(_pair_part, [(geometry, models.take(part), directions, halvings, at_roots) for part in parts])
+    w = len(models.degree)
+    out = np.zeros((w, len(directions)), dtype=np.int8)
+    free = np.zeros(w, dtype=bool)
+    for part, (signs, part_free) in zip(parts, got):
+        at = np.flatnonzero(models.window_renumber(part) >= 0)  # this part's windows, in the order take() keeps
+        out[at] = signs
+        free[at] = part_free
+    return out, free
+
+
+def _pair_part(geometry: Geometry, models: WindowModels, directions: np.ndarray, halvings: int,
+               at_roots: bool) -> tuple[np.ndarray, np.ndarray]:
+    return pair_direction_signs(geometry, models, np.arange(len(models.ok)), directions, halvings, at_roots)
 
 
 def _edge_slopes(geometry: Geometry, models: WindowModels, rows: np.ndarray, rising: np.ndarray, window: np.ndarray,

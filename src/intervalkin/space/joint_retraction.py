@@ -53,6 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Workers
 from intervalkin.space.retraction_nodes import MAX_PAIR_WINDOWS, MAX_ROOTS, Nodes, clear_nodes, fold_nodes, window_nodes
 from intervalkin.space.retraction_ranks import LEFT, RET, SINK, retraction_ranks
 
@@ -136,15 +137,15 @@ class JointRetraction:
                 "seconds": round(self.seconds, 2)}
 
 
-def retract_joint_paving(jp, geometry: Geometry) -> JointRetraction:
+def retract_joint_paving(jp, geometry: Geometry, workers: Workers | None = None) -> JointRetraction:
     """The nodes of the leaves of ``jp`` (a :class:`~intervalkin.space.joint_paving.JointSpacePaving`) and
-    their retraction ranks (module docstring)."""
+    their retraction ranks (module docstring); ``workers``: processes sharing the window nodes' direction signs."""
     t0 = time.perf_counter()
     n = len(jp.cell)
     nodes = Nodes()
     clear_nodes(jp, nodes)
     fold_nodes(jp, nodes)
-    left_rows = window_nodes(jp, geometry, nodes)
+    left_rows = window_nodes(jp, geometry, nodes, workers)
     covered = np.zeros(n, dtype=bool)
     for part in nodes.parts:
         covered[part[0]] = True

@@ -27,6 +27,7 @@ import dataclasses
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Workers, default_workers
 from intervalkin.space.joint_closure import Closure, closed_cells
 from intervalkin.space.joint_paving import JointSpacePaving, pave_joint_space
 from intervalkin.space.joint_retraction import retract_joint_paving
@@ -48,7 +49,8 @@ def pave_joint_topology(geometry: Geometry, depth: int, join_levels: int, progre
     cells = pave_joint_space(geometry, depth, join_levels, progress=progress, **levels)
     cells, separation = refine_separations(geometry, cells, separated_cells(cells, geometry), depth, join_levels,
                                            progress, **levels)
-    cells = dataclasses.replace(cells, retraction=retract_joint_paving(cells, geometry))
+    with Workers(default_workers()) as workers:
+        cells = dataclasses.replace(cells, retraction=retract_joint_paving(cells, geometry, workers))
     return cells, closed_cells(cells, geometry), separation
 
 

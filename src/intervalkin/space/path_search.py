@@ -3,7 +3,7 @@
 Nothing here certifies anything: the paving only PROPOSES the path, which
 :func:`intervalkin.space.segment.certify_segment` then proves segment by segment.
 
-1. Box path.  A* (exact for its metric) in the face-adjacency graph of the
+1. Box path.  Dijkstra's search (scipy; exact for its metric) in the face-adjacency graph of the
    paving boxes certified INSIDE the aspect, from the box nearest the start
    pose to the box nearest the goal.  Edge weight: the distance of the box
    centres in the metric ``sqrt(dx^2 + dy^2 + (L dphi)^2)``, dphi taken modulo
@@ -25,10 +25,11 @@ the regions crossed by the path.
 
 from __future__ import annotations
 
-import heapq
 import math
 
 import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI
@@ -73,7 +74,9 @@ def _point_box_distance(p: np.ndarray, lo: np.ndarray, hi: np.ndarray, L: float)
 
 def shortest_box_path(paving: Paving, edges: np.ndarray, name: str, start: np.ndarray, goal: np.ndarray,
                        L: float) -> np.ndarray | None:
-    """Indices of the boxes of a shortest path (A*), or None when start and goal are not connected."""
+    """Indices of the boxes of a shortest path (face contacts weighted by :func:`path_distance` between box
+    centres), or None when start and goal are not connected.  Dijkstra's search in scipy (compiled): a pure
+    Python A* spent about 8 s per path on the paper's depth-8 aspects."""
     inside = paving.labels[name] == Label.INSIDE
     nodes = np.flatnonzero(inside)
     if nodes.size == 0:
@@ -82,43 +85,21 @@ def shortest_box_path(paving: Paving, edges: np.ndarray, name: str, start: np.nd
     centre = 0.5 * (lo + hi)
     s = int(np.argmin(_point_box_distance(start, lo, hi, L)))
     t = int(np.argmin(_point_box_distance(goal, lo, hi, L)))
+    if s == t:
+        return nodes[[s]]
     local = np.full(len(paving), -1, dtype=np.int64)
     local[nodes] = np.arange(nodes.size)
     e = edges[:, inside[edges[0]] & inside[edges[1]]]
-    u = np.concatenate([local[e[0]], local[e[1]]])
-    v = np.concatenate([local[e[1]], local[e[0]]])
-    w = path_distance(centre[u], centre[v], L)
-    order = np.argsort(u, kind="stable")
-    u, v, w = u[order], v[order], w[order]
-    indptr = np.concatenate([[0], np.cumsum(np.bincount(u, minlength=nodes.size))]).tolist()
-    nbr, wt = v.tolist(), w.tolist()
-    h = path_distance(centre, centre[t], L).tolist()  # consistent heuristic: the same metric
-    # flat lists, not dicts and sets: the loop below is the path search's hot spot (pure Python, one node at a time)
-    dist = [math.inf] * nodes.size
-    prev = [-2] * nodes.size  # -2: not reached; -1: the start
-    closed = bytearray(nodes.size)
-    dist[s], prev[s] = 0.0, -1
-    heap = [(h[s], 0.0, s)]
-    pop, push = heapq.heappop, heapq.heappush
-    while heap:
-        _, g, a = pop(heap)
-        if closed[a]:
-            continue
-        if a == t:
-            break
-        closed[a] = 1
-        for k in range(indptr[a], indptr[a + 1]):
-            b = nbr[k]
-            nd = g + wt[k]
-            if nd < dist[b]:
-                dist[b] = nd
-                prev[b] = a
-                push(heap, (nd + h[b], nd, b))
-    if prev[t] == -2:
+    # one entry per contact: csr_matrix adds up repeated entries, which would lengthen a contact listed twice
+    key = np.unique(np.minimum(local[e[0]], local[e[1]]) * nodes.size + np.maximum(local[e[0]], local[e[1]]))
+    u, v = key // nodes.size, key % nodes.size
+    graph = csr_matrix((path_distance(centre[u], centre[v], L), (u, v)), shape=(nodes.size, nodes.size))
+    dist, prev = dijkstra(graph, directed=False, indices=s, return_predecessors=True)
+    if not np.isfinite(dist[t]):
         return None
     path = [t]
-    while prev[path[-1]] >= 0:
-        path.append(prev[path[-1]])
+    while path[-1] != s:
+        path.append(int(prev[path[-1]]))
     return nodes[np.array(path[::-1], dtype=np.int64)]
 
 

@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
+from intervalkin.core.workers import Workers
 from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
 from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, STEADY, base_signature, pair_direction_signs,
                                           pair_windows, window_kinds)
@@ -176,8 +177,9 @@ def fold_nodes(jp, nodes: Nodes) -> None:
         nodes.add(pieces.box[keep], s, _kind(cell, s), 1, cell, faces[:, None, :])
 
 
-def window_nodes(jp, geometry: Geometry, nodes: Nodes) -> np.ndarray:
-    """Nodes of the window-modelled leaves; returns the rows left without nodes (their leaves are LEFT)."""
+def window_nodes(jp, geometry: Geometry, nodes: Nodes, workers: Workers | None = None) -> np.ndarray:
+    """Nodes of the window-modelled leaves; returns the rows left without nodes (their leaves are LEFT).
+    ``workers`` share the direction signs of the pair windows (most of the time)."""
     win = jp.windows
     if win is None or win.folds is None:
         return np.zeros(0, dtype=np.int64)
@@ -207,7 +209,8 @@ def window_nodes(jp, geometry: Geometry, nodes: Nodes) -> np.ndarray:
     nodes.add(win.leaf[fixed], base[fixed], RET, 2, -1, EACH_FACE, plane=(split, fixed))
     rows = np.flatnonzero(open_rows & only_pairs & (n_pair >= 1))
     if rows.size:
-        signs, free = pair_direction_signs(geometry, models, rows, DIRECTIONS, halvings=PAIR_HALVINGS, at_roots=True)
+        signs, free = pair_direction_signs(geometry, models, rows, DIRECTIONS, halvings=PAIR_HALVINGS, at_roots=True,
+                                           workers=workers)
         # a free window (no critical piece: u > 0 on the whole box) never holds roots and keeps every direction,
         # so only the others make patterns
         live = pair & ~free
