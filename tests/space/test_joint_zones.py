@@ -165,3 +165,26 @@ def test_no_pass_when_nothing_is_between(monkeypatch):
     monkeypatch.setattr(jt, "pave_joint_space", lambda *a, **k: pytest.fail("paved again with nothing between"))
     cells, sep = jt.refine_separations(None, first, first.separation, DEPTH, 0)
     assert cells is first and sep.zone_passes == ()
+
+
+@pytest.mark.parametrize("replaced", [False, True])
+def test_the_topology_s_retraction_and_separations_are_those_of_the_paving_it_returns(monkeypatch, paper_geometry,
+                                                                                      fold_paving, plain, replaced):
+    """pave_joint_topology computes the separations beside the first paving's retraction: the retraction it returns
+    is the one of the paving it returns (made again when a zone pass replaced the first), and the separations are
+    those of the first paving when no pass ran."""
+    from intervalkin.space import joint_topology
+    from intervalkin.space.joint_retraction import retract_joint_paving
+
+    monkeypatch.setattr(joint_topology, "pave_joint_space", lambda *a, **k: fold_paving)
+    # no pass, or a pass that keeps a finer paving (here another paving stands for it)
+    monkeypatch.setattr(joint_topology, "refine_separations",
+                        lambda g, cells, sep, *a, **k: (plain, separated_cells(plain, g)) if replaced else (cells, sep))
+    cells, closure, separation = joint_topology.pave_joint_topology(paper_geometry, 5, 1)
+    final = plain if replaced else fold_paving
+    assert cells.paving is final.paving
+    assert separation == separated_cells(final, paper_geometry)
+    want = retract_joint_paving(final, paper_geometry)
+    got = cells.retraction
+    assert got.leaf.size == want.leaf.size and np.array_equal(got.leaf, want.leaf)
+    assert np.array_equal(got.rank, want.rank) and np.array_equal(got.signature, want.signature)

@@ -27,7 +27,7 @@ import dataclasses
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.workers import Workers, default_workers
+from intervalkin.core.workers import Beside, Workers, default_workers
 from intervalkin.space.joint_closure import Closure, closed_cells
 from intervalkin.space.joint_paving import JointSpacePaving, pave_joint_space
 from intervalkin.space.joint_retraction import retract_joint_paving
@@ -46,12 +46,22 @@ def pave_joint_topology(geometry: Geometry, depth: int, join_levels: int, progre
                         **levels) -> tuple[JointSpacePaving, Closure, Separation]:
     """(the paving of :func:`~intervalkin.space.joint_paving.pave_joint_space` with its open layer's retraction
     into the cells, its closed cells, its separations), after the zone passes of the module docstring."""
-    cells = pave_joint_space(geometry, depth, join_levels, progress=progress, **levels)
-    cells, separation = refine_separations(geometry, cells, separated_cells(cells, geometry), depth, join_levels,
-                                           progress, **levels)
-    with Workers(default_workers()) as workers:
-        cells = dataclasses.replace(cells, retraction=retract_joint_paving(cells, geometry, workers))
+    first = pave_joint_space(geometry, depth, join_levels, progress=progress, **levels)
+    # the separations are serial: a second process computes them while this one retracts the same paving, which
+    # stands unless a zone pass replaces it (then it is retracted again)
+    with Beside(separated_cells, first, geometry) as side:
+        retraction = _retraction(first, geometry)
+        separation = side.result()
+    cells, separation = refine_separations(geometry, first, separation, depth, join_levels, progress, **levels)
+    if cells is not first:
+        retraction = _retraction(cells, geometry)
+    cells = dataclasses.replace(cells, retraction=retraction)
     return cells, closed_cells(cells, geometry), separation
+
+
+def _retraction(cells: JointSpacePaving, geometry: Geometry):
+    with Workers(default_workers()) as workers:
+        return retract_joint_paving(cells, geometry, workers)
 
 
 def refine_separations(geometry: Geometry, cells: JointSpacePaving, separation: Separation, depth: int,
