@@ -169,19 +169,21 @@ def test_no_pass_when_nothing_is_between(monkeypatch):
 
 @pytest.mark.parametrize("replaced", [False, True])
 def test_the_topology_s_retraction_and_separations_are_those_of_the_paving_it_returns(monkeypatch, paper_geometry,
-                                                                                      fold_paving, plain, replaced):
+                                                                                      plain, zoned, replaced):
     """pave_joint_topology computes the separations beside the first paving's retraction: the retraction it returns
     is the one of the paving it returns (made again when a zone pass replaced the first), and the separations are
-    those of the first paving when no pass ran."""
+    those of the first paving when no pass ran.  The small pavings of this module stand for the topology's (the
+    plumbing is the same; the retraction's window nodes have their own tests)."""
     from intervalkin.space import joint_topology
     from intervalkin.space.joint_retraction import retract_joint_paving
 
-    monkeypatch.setattr(joint_topology, "pave_joint_space", lambda *a, **k: fold_paving)
+    finer = zoned[1]
+    monkeypatch.setattr(joint_topology, "pave_joint_space", lambda *a, **k: plain)
     # no pass, or a pass that keeps a finer paving (here another paving stands for it)
     monkeypatch.setattr(joint_topology, "refine_separations",
-                        lambda g, cells, sep, *a, **k: (plain, separated_cells(plain, g)) if replaced else (cells, sep))
-    cells, closure, separation = joint_topology.pave_joint_topology(paper_geometry, 5, 1)
-    final = plain if replaced else fold_paving
+                        lambda g, cells, sep, *a, **k: (finer, separated_cells(finer, g)) if replaced else (cells, sep))
+    cells, closure, separation = joint_topology.pave_joint_topology(paper_geometry, DEPTH, 0)
+    final = finer if replaced else plain
     assert cells.paving is final.paving
     assert separation == separated_cells(final, paper_geometry)
     want = retract_joint_paving(final, paper_geometry)
