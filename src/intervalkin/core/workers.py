@@ -101,10 +101,12 @@ class Workers:
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
 
-    def parts(self, n: int) -> list[tuple[int, int]]:
+    def parts(self, n: int, least: int | None = None) -> list[tuple[int, int]]:
         """Contiguous ranges [start, stop) covering range(n): :data:`PARTS_PER_PROCESS` per process (parts no
-        smaller than half the threshold), or one when n is below the threshold or there is one process."""
-        least = MIN_PARALLEL_ITEMS if self.min_items is None else self.min_items
+        smaller than half the threshold), or one when n is below the threshold or there is one process.
+        ``least``: the threshold for this call (default: the pool's ``min_items``, else MIN_PARALLEL_ITEMS)."""
+        if least is None:
+            least = MIN_PARALLEL_ITEMS if self.min_items is None else self.min_items
         k = 1 if self.count == 1 or n < least else max(2, min(PARTS_PER_PROCESS * self.count, 2 * n // max(least, 1)))
         cuts = [n * i // k for i in range(k + 1)]
         return [(cuts[i], cuts[i + 1]) for i in range(k)]

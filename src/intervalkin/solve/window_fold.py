@@ -56,8 +56,8 @@ __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", 
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
-#: Boxes from which pair_direction_signs splits its work between processes, and parts per process.
-MIN_PARALLEL_BOXES, PARTS_PER_WORKER = 400, 4
+#: Boxes from which pair_direction_signs splits its work between processes.
+MIN_PARALLEL_BOXES = 400
 #: pair_direction_signs(at_roots=True) for a window whose status no point of the box changes (every direction keeps it).
 STEADY = 2
 #: What the two roots of a pair window add to a signature (count, n_wa1, n_wa2).
@@ -312,9 +312,7 @@ def _pair_direction_parts(geometry: Geometry, models: WindowModels, rows: np.nda
                           halvings: int, at_roots: bool, workers: Workers) -> tuple[np.ndarray, np.ndarray]:
     """:func:`pair_direction_signs` with the boxes ``rows`` cut into parts, one call each on their models alone."""
     rows = np.unique(rows)  # take() wants increasing rows; every window is then in exactly one part
-    k = min(rows.size // (MIN_PARALLEL_BOXES // 2), PARTS_PER_WORKER * workers.count)
-    cuts = [rows.size * i // k for i in range(k + 1)]
-    parts = [rows[cuts[i]:cuts[i + 1]] for i in range(k)]
+    parts = [rows[a:b] for a, b in workers.parts(rows.size, least=MIN_PARALLEL_BOXES)]
     got = workers.run(_pair_part, [(geometry, models.take(part), directions, halvings, at_roots) for part in parts])
     w = len(models.degree)
     out = np.zeros((w, len(directions)), dtype=np.int8)
