@@ -1,7 +1,10 @@
-"""Shared fixtures: the paper's manipulator and a seeded RNG."""
+"""Shared fixtures: the paper's manipulator and a seeded RNG, and the pavings many test files read."""
 
 from __future__ import annotations
 
+import fcntl
+import os
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +13,28 @@ import pytest
 from intervalkin.core.geometry import default_geometry
 
 DATA = Path(__file__).parent / "data"
+
+
+def built_once(tmp_path_factory, name: str, build):
+    """``build()``, computed by one xdist worker of the run and read by the others from a pickle.
+
+    Session fixtures are per worker: a paving read by test files that land on both workers would be
+    paved twice (the windowed depth-5 one costs about 30 s).  The first worker to ask builds it under
+    an exclusive lock in the run's shared temporary folder; a worker asking later waits for the lock and
+    loads the file.  Each worker gets its own copy, so the fixtures stay read-only by convention only."""
+    if os.environ.get("PYTEST_XDIST_WORKER") is None:
+        return build()
+    root = tmp_path_factory.getbasetemp().parent  # shared by the workers of one run
+    path = root / f"{name}.pickle"
+    with open(root / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if path.is_file():
+            return pickle.loads(path.read_bytes())
+        value = build()
+        part = root / f"{name}.pickle.part"
+        part.write_bytes(pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL))
+        part.replace(path)  # a worker never reads half a file
+        return value
 
 
 @pytest.fixture(scope="session")
@@ -46,11 +71,11 @@ def small_chain(geometry, workspace_depth: int, joint_depth: int, regions_depth:
 
 
 @pytest.fixture(scope="session")
-def regions_chain(paper_geometry):
+def regions_chain(paper_geometry, tmp_path_factory):
     """The chain shared by space/test_basic_region.py, space/test_basic_region_properties.py and the depth-7
     test of space/test_trajectory.py (built once, about 8 s): workspace depth 7, joint grid 2**6, regions at
     depth 7.  Read only."""
-    return small_chain(paper_geometry, 7, 6, 7, max_solves=200)
+    return built_once(tmp_path_factory, "regions_chain", lambda: small_chain(paper_geometry, 7, 6, 7, max_solves=200))
 
 
 @pytest.fixture(scope="session")
@@ -62,12 +87,14 @@ def aspect_topology(paper_geometry):
 
 
 @pytest.fixture(scope="session")
-def fold_paving(paper_geometry):
+def fold_paving(paper_geometry, tmp_path_factory):
     """The joint box paved directly with fold models and window models, depth 5 and one join level: the
-    source of the ``joint_fold_model`` and ``joint_join`` claims in tests/certify and tests/checker."""
+    source of the ``joint_fold_model`` and ``joint_join`` claims in tests/certify and tests/checker (about
+    30 s, read by 17 test files: built once a run)."""
     from intervalkin.space.joint_paving import pave_joint_space
 
-    return pave_joint_space(paper_geometry, 5, 1, fold=True, model_levels=1, windows=True)
+    return built_once(tmp_path_factory, "fold_paving",
+                      lambda: pave_joint_space(paper_geometry, 5, 1, fold=True, model_levels=1, windows=True))
 
 
 @pytest.fixture(scope="session")
@@ -80,12 +107,14 @@ def joint_paving_4(paper_geometry):
 
 
 @pytest.fixture(scope="session")
-def fold_models_5(paper_geometry):
+def fold_models_5(paper_geometry, tmp_path_factory):
     """The joint box paved at depth 5 with local models (one model level) and no joins: shared by
-    solve/test_fold_model.py (its fold pieces) and solve/test_local_model.py (its voided boxes).  Read only."""
+    solve/test_fold_model.py (its fold pieces), solve/test_local_model.py (its voided boxes) and
+    checker/test_joint_claims.py (its clear groups joined only by fold pieces).  Read only."""
     from intervalkin.space.joint_paving import pave_joint_space
 
-    return pave_joint_space(paper_geometry, 5, join_levels=0, fold=True, model_levels=1)
+    return built_once(tmp_path_factory, "fold_models_5",
+                      lambda: pave_joint_space(paper_geometry, 5, join_levels=0, fold=True, model_levels=1))
 
 
 SECOND_DESIGN = Path(__file__).parents[1] / "examples" / "second_design_0246.toml"

@@ -413,16 +413,15 @@ def test_side_test_agrees_with_the_library_and_with_solves(paper_geometry, fold_
     assert agreed >= 30 and counted >= 15
 
 
-def test_component_joins_link_clear_components(paper_geometry):
-    """Without join levels, at depth 6, cells of the paper's manipulator are several face-connected groups of
-    clear boxes that only fold pieces join (with the local models, fold and voided boxes along g(S), there are
-    dozens): the writer plans one component join per group beyond the first of each cell, and the two written
-    come first, end in clear boxes of two different groups of one cell, and verify (about 30 s: the paving)."""
+def test_component_joins_link_clear_components(paper_geometry, fold_models_5):
+    """Without join levels, cells of the paper's manipulator are several face-connected groups of clear boxes
+    that only fold pieces join (with the local models, fold and voided boxes along g(S); 28 groups beyond the
+    first of each cell at depth 5): the writer plans one component join per group beyond the first of each
+    cell, and the two written come first, end in clear boxes of two different groups of one cell, and verify."""
     from intervalkin.certify.joint_claims import joint_claims
     from intervalkin.paving.adjacency import component_labels, shares_face
-    from intervalkin.space.joint_paving import pave_joint_space
 
-    jsp = pave_joint_space(paper_geometry, 6, 0, fold=True, model_levels=1)
+    jsp = fold_models_5  # pave_joint_space(paper_geometry, 5, 0, fold=True, model_levels=1), tests/conftest.py
     models, joins, omitted = joint_claims(paper_geometry, jsp, max_joins=2, max_models=8)
     pav = jsp.paving
     clear = jsp.cell >= 0
