@@ -30,7 +30,8 @@ from intervalkin.kinematics.reduced_equation import (
 )
 from intervalkin.kinematics.sextic import laurent_value, reduction
 from intervalkin.solve.dkp import solve
-from intervalkin.solve.simple_roots import initial_pieces, open_pieces
+from intervalkin.solve import simple_roots
+from intervalkin.solve.simple_roots import ReducedBoxes, basis_waves, initial_pieces, open_pieces, trig_basis
 from tests.solve.shared import box_across_singular_image, concurrent_legs_box
 from tests.solve.shared import split_of as _split
 
@@ -79,6 +80,9 @@ def test_ball_operations_enclose_exact_values(mids, rads, ts, k, deriv):
     assert Fraction(float(dot.lo)) <= pa[0] * pb[0] + pa[1] * pb[1] <= Fraction(float(dot.hi))
     mat = a.matmul(Ball(np.array([[mids[2]], [mids[3]]]), np.array([[rads[2]], [rads[3]]]))).to_interval()
     assert Fraction(float(mat.lo[0])) <= pa[0] * pb[0] + pa[1] * pb[1] <= Fraction(float(mat.hi[0]))
+    rows = Ball(a.mid[None, None, :], a.rad[None, None, :]).row_matmul(
+        Ball(np.array([[[mids[2]], [mids[3]]]]), np.array([[[rads[2]], [rads[3]]]]))).to_interval()
+    assert Fraction(float(rows.lo[0, 0, 0])) <= pa[0] * pb[0] + pa[1] * pb[1] <= Fraction(float(rows.hi[0, 0, 0]))
     phi = Ball(np.array([mids[0] / 20]), np.array([rads[0]]))
     c, s = cos_sin_multiple(phi, k, deriv)
     point = _q(mids[0] / 20) + (2 * _q(ts[0]) - 1) * _q(rads[0])
@@ -88,6 +92,28 @@ def test_ball_operations_enclose_exact_values(mids, rads, ts, k, deriv):
         for ball, value in zip((c, s), exact):
             iv = ball.to_interval()
             assert arb(float(iv.lo[0])) <= value * k**deriv <= arb(float(iv.hi[0]))
+
+
+def test_enclosures_in_blocks_are_those_of_each_row(paper_geometry, monkeypatch):
+    """The enclosure of a long array of (box, piece) rows, taken in blocks, is row by row the enclosure of that
+    row alone (a block put back out of order, or the bases of one row paired with another's box, would show);
+    and the cos and sin shared by its three bases are the ones each would compute."""
+    rng = np.random.default_rng(3)
+    lo = rng.uniform(10, 31.5, size=(40, 3))
+    data = ReducedBoxes(paper_geometry, _boxes(lo, 0.05))
+    owner = np.sort(rng.integers(0, 40, 300))
+    a = rng.uniform(-np.pi, 3.0, 300)
+    b = a + rng.choice([1e-3, 0.05, 0.1], 300)
+    monkeypatch.setattr(simple_roots, "_ROWS", 64)
+    for deriv in range(4):
+        whole = data.enclosure(owner, a, b, deriv)
+        for i in rng.choice(300, 12, replace=False):
+            alone = data.enclosure(owner[i:i + 1], a[i:i + 1], b[i:i + 1], deriv)
+            assert (whole.lo[i], whole.hi[i]) == (alone.lo[0], alone.hi[0])
+    phi = Ball.from_interval(Interval(a, b))
+    for deriv in range(3):
+        shared, own = trig_basis(phi, deriv, basis_waves(phi.mid)), trig_basis(phi, deriv)
+        assert np.array_equal(shared.mid, own.mid) and np.array_equal(shared.rad, own.rad)
 
 
 def test_ball_from_interval_contains_the_interval():

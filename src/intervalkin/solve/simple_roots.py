@@ -49,12 +49,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from intervalkin.core.ball import Ball, cos_sin_multiple
+from intervalkin.core.ball import Ball, cos_sin_at, cos_sin_multiple
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, Interval
 from intervalkin.kinematics.reduced_equation import HARMONICS, MONOMIALS, reduced_equation
 
-__all__ = ["initial_pieces", "open_pieces", "ReducedBoxes", "trig_basis", "PIECES", "HALVINGS"]
+__all__ = ["initial_pieces", "open_pieces", "ReducedBoxes", "trig_basis", "basis_waves", "PIECES", "HALVINGS"]
 
 #: Pieces of the orientation circle tried first on every box.
 PIECES = 24
@@ -64,12 +64,18 @@ HALVINGS = 7
 _CROWD = 24
 #: Boxes tested together (memory: about 40 kB per box at the first round).
 _CHUNK = 4096
+#: Rows of (box, piece) pairs an enclosure takes at once: past about 2^16 its temporaries leave the cache and
+#: a row costs twice as much.
+_ROWS = 2**14
 #: Pieces narrower than this are not bisected further (float resolution of phi, with margin).
 _MIN_WIDTH = 2.0**-30
 
 
-def trig_basis(phi: Ball, deriv: int = 0) -> Ball:
-    """(m, 7) balls of the deriv-th phi-derivative of the basis (1, cos phi, sin phi, ...) over phi (m,)."""
+def trig_basis(phi: Ball, deriv: int = 0, waves: dict | None = None) -> Ball:
+    """(m, 7) balls of the deriv-th phi-derivative of the basis (1, cos phi, sin phi, ...) over phi (m,).
+
+    ``waves``: :func:`basis_waves` of ``phi.mid``, when several bases are taken about the same midpoints (the
+    same floats: the same balls, without computing cos and sin again)."""
     mids, rads = [], []
     for k, is_sin in HARMONICS:
         if k == 0:
@@ -78,10 +84,16 @@ def trig_basis(phi: Ball, deriv: int = 0) -> Ball:
             continue
         if is_sin:
             continue
-        c, s = cos_sin_multiple(phi, k, deriv)
+        c, s = cos_sin_multiple(phi, k, deriv, None if waves is None else waves[k])
         mids += [c.mid, s.mid]
         rads += [c.rad, s.rad]
     return Ball(np.stack(mids, axis=-1), np.stack(rads, axis=-1))
+
+
+def basis_waves(mid: np.ndarray) -> dict:
+    """{k: (cos k mid, sin k mid)} for the harmonics of the basis: what :func:`trig_basis` shares between bases
+    about the same midpoints."""
+    return {k: cos_sin_at(mid, k) for k, is_sin in HARMONICS if k and not is_sin}
 
 
 class ReducedBoxes:
@@ -122,9 +134,13 @@ class ReducedBoxes:
         monos = _stack([_stack(row) for row in rows], axis=1)  # (n, 4, 10)
         Ct = Ball(C.mid.T.copy(), C.rad.T.copy())  # (10, 7)
         self.taylor = monos.matmul(Ct)  # (n, 4, 7): c(r_c) and its three r-derivatives
+        # the same, each box's matrix transposed and contiguous (7, 4), for the stacked products of the enclosures
+        self.taylor_t = Ball(np.ascontiguousarray(self.taylor.mid.transpose(0, 2, 1)),
+                             np.ascontiguousarray(self.taylor.rad.transpose(0, 2, 1)))
         # second-order part, sum_h w_h Q_h(d): the quadratic coefficients as rows (6, 7), d-bounds per box
         quad = [m for m, e in enumerate(MONOMIALS) if len(e) == 2]
         self.quad_rows = Ball(C.mid[:, quad].T.copy(), C.rad[:, quad].T.copy())  # (6, 7)
+        self.quad_t = Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy())  # (7, 6)
         h = self.half
         self.quad_square = np.array([MONOMIALS[m][0] == MONOMIALS[m][1] for m in quad])
         self.quad_bound = np.stack([h[:, MONOMIALS[m][0]] * h[:, MONOMIALS[m][1]] for m in quad], axis=1) * (1.0 + 2.0**-40)
@@ -139,34 +155,43 @@ class ReducedBoxes:
         """Enclosure of d^deriv f / dphi^deriv over (box owner, piece [lo, hi]).
 
         Mean value in phi, f(R, phi_m) + d_phi f(R, Phi) (Phi - phi_m), intersected
-        with the natural form f(R, Phi); each with the exact Taylor form in r.
+        with the natural form f(R, Phi); each with the exact Taylor form in r.  The three
+        bases (at phi_m, and over Phi for the slope and the natural form) share their cos and sin,
+        and go through the Taylor form together.  Long arrays are taken in blocks of :data:`_ROWS` rows
+        (the temporaries of a block stay in cache; the enclosures are the same).
         """
-        taylor = self.taylor[owner]
-        half = self.half[owner]
+        if len(owner) > _ROWS:
+            parts = [self.enclosure(owner[i:i + _ROWS], lo[i:i + _ROWS], hi[i:i + _ROWS], deriv)
+                     for i in range(0, len(owner), _ROWS)]
+            return Interval(np.concatenate([e.lo for e in parts]), np.concatenate([e.hi for e in parts]))
         piece = Ball.from_interval(Interval(lo, hi))
-
-        def over_r(w: Ball) -> Ball:
-            if self.at_points:
-                return w.dot(self.values[owner])
-            t = w.dot_rows(taylor)  # (m, 4)
-            spread = np.einsum("mi,mi->m", np.abs(t.mid[:, 1:]) + t.rad[:, 1:], half)
-            q = w.matmul(Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy()))  # (m, 6)
-            bound = self.quad_bound[owner]
-            # d_i^2 lies in [0, h_i^2]: q d_i^2 in q h^2 / 2 +- |q| h^2 / 2; d_i d_j in [-h_i h_j, h_i h_j]
-            sq = self.quad_square
-            centre = np.einsum("mk,mk->m", q.mid[:, sq], 0.5 * bound[:, sq])
-            second = (np.einsum("mk,mk->m", np.abs(q.mid[:, sq]) + 2.0 * q.rad[:, sq], 0.5 * bound[:, sq])
-                      + np.einsum("mk,mk->m", np.abs(q.mid[:, ~sq]) + q.rad[:, ~sq], bound[:, ~sq]))
-            mid = t.mid[:, 0] + centre
-            extra = (spread + second + 2.0**-40 * np.abs(centre)) * (1.0 + 2.0**-40) + 2.0**-1000
-            return Ball(mid, t.rad[:, 0] + extra)
-
-        at_mid = over_r(trig_basis(Ball.point(piece.mid), deriv))
-        slope = over_r(trig_basis(piece, deriv + 1))
+        waves = basis_waves(piece.mid)
+        bases = [trig_basis(Ball.point(piece.mid), deriv, waves), trig_basis(piece, deriv + 1, waves),
+                 trig_basis(piece, deriv, waves)]
+        if self.at_points:
+            at_mid, slope, natural = (w.dot(self.values[owner]) for w in bases)
+        else:
+            both = self._over_r(owner, Ball(np.stack([w.mid for w in bases], axis=1),
+                                            np.stack([w.rad for w in bases], axis=1)))  # (m, 3)
+            at_mid, slope, natural = (both[:, i] for i in range(3))
         mv = (at_mid + slope * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
-        natural = over_r(trig_basis(piece, deriv)).to_interval()
-        return mv.intersect(natural)
+        return mv.intersect(natural.to_interval())
 
+    def _over_r(self, owner: np.ndarray, w: Ball) -> Ball:
+        """sum_h c_h(r) w_h over R^2 of box owner[i], for each basis row w[i, l] (m, l, 7): balls (m, l)."""
+        t = w.row_matmul(self.taylor_t[owner])  # (m, l, 4): c(r_c) . w and its three r-derivatives
+        half = self.half[owner]
+        spread = np.einsum("mli,mi->ml", np.abs(t.mid[..., 1:]) + t.rad[..., 1:], half)
+        q = w.matmul(self.quad_t)  # (m, l, 6)
+        bound = self.quad_bound[owner]
+        # d_i^2 lies in [0, h_i^2]: q d_i^2 in q h^2 / 2 +- |q| h^2 / 2; d_i d_j in [-h_i h_j, h_i h_j]
+        sq = self.quad_square
+        centre = np.einsum("mlk,mk->ml", q.mid[..., sq], 0.5 * bound[:, sq])
+        second = (np.einsum("mlk,mk->ml", np.abs(q.mid[..., sq]) + 2.0 * q.rad[..., sq], 0.5 * bound[:, sq])
+                  + np.einsum("mlk,mk->ml", np.abs(q.mid[..., ~sq]) + q.rad[..., ~sq], bound[:, ~sq]))
+        mid = t.mid[..., 0] + centre
+        extra = (spread + second + 2.0**-40 * np.abs(centre)) * (1.0 + 2.0**-40) + 2.0**-1000
+        return Ball(mid, t.rad[..., 0] + extra)
 
     def r_slope(self, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray, axis: int, deriv: int = 0) -> Interval:
         """Enclosure of d^(1 + deriv) f / d r_axis d phi^deriv over (box owner, piece [lo, hi]), r_axis = rho_axis^2.
