@@ -18,8 +18,8 @@ piece of a face (a common edge or corner is not enough).  In an x-phi section
 
 All adjacency pairs are computed in bulk from the integer coordinates: along an
 axis, a "+" face and a "-" face on the same plane overlap in 2-D exactly when one
-dyadic square contains the other, so each face looks up its ancestors' keys
-(one sorted search per level).
+dyadic square contains the other, so each box looks up the box across each of its
+sides by the Z-order code of one finest cell (one sorted search per side).
 """
 
 from __future__ import annotations
@@ -32,67 +32,61 @@ __all__ = ['shares_face', 'shares_face_bruteforce', 'directed_face_pairs', 'touc
 # --------------------------------------------------------------------------------------
 # Adjacency
 # --------------------------------------------------------------------------------------
-def _face_keys(plane, lev, a, b, nbits):
-    return ((plane * 64 + lev) << (2 * nbits)) | (a << nbits) | b
-
-
 def shares_face(level: np.ndarray, ijk: np.ndarray, depth: int, periodic=(False, False, True)) -> np.ndarray:
-    """Face-adjacent pairs of a paving, as a (2, m) int64 array with row 0 < row 1.
+    """Face-adjacent pairs of a paving, as a (2, m) int64 array with row 0 < row 1, sorted by (row 0, row 1).
 
     Parameters
     ----------
     level : (n,) ints, ijk : (n, 3) ints, integer coordinates of boxes that tile
-        (part of) the domain without overlapping; depth >= max(level).
+        (part of) the domain without overlapping; max(level) <= depth <= 21.
     periodic : which axes wrap (default: phi, so phi = +pi touches phi = -pi).
 
-    Two boxes are adjacent when they share a 2-D piece of a face.  Cost:
-    O((depth + 1) * n log n) for each of the three axes.
+    Two boxes are adjacent when they share a 2-D piece of a face.  How: faces of dyadic boxes on one
+    plane share a 2-D piece exactly when one contains the other, so of two adjacent boxes the finer one
+    (either, at equal levels) has the other across its face, holding the finest cell next to its own lowest
+    corner.  Each box looks up, on each of its six sides, the box holding that finest cell (a sorted search
+    of Z-order codes, :func:`_morton`; a gap of a partial tiling holds none) and keeps it when it is not
+    finer; at equal levels only the "+" side keeps it, so that a pair is found once.  Cost: six sorted
+    searches per box.
     """
     level = np.asarray(level, dtype=np.int64)
     ijk = np.asarray(ijk, dtype=np.int64)
     n = level.shape[0]
     if n == 0:
         return np.zeros((2, 0), dtype=np.int64)
+    if depth > _MORTON_BITS:
+        raise ValueError(f"shares_face: depth must be at most {_MORTON_BITS}, got {depth}")
     nfine = np.int64(1) << depth
     shift = depth - level
-    nbits = depth + 1
+    corner = ijk << shift[:, None]
+    start = _morton(corner, depth)
+    order = np.argsort(start, kind="stable")
+    starts = start[order]
+    ends = starts + (np.int64(1) << (3 * shift[order]))  # a box holds the codes [start, end)
+    found_level = level[order]
     pairs = []
-    present = np.bincount(level, minlength=depth + 1) > 0  # a face of level L needs a box of level L
     for ax in range(3):
-        o1, o2 = [a for a in range(3) if a != ax]
-        plus_plane = (ijk[:, ax] + 1) << shift
-        minus_plane = ijk[:, ax] << shift
-        if periodic[ax]:
-            plus_plane = np.where(plus_plane == nfine, 0, plus_plane)
-        # "+" faces keyed at their own level
-        pk = _face_keys(plus_plane, level, ijk[:, o1], ijk[:, o2], nbits)
-        order = np.argsort(pk, kind="stable")
-        pk_sorted = pk[order]
-        mk = _face_keys(minus_plane, level, ijk[:, o1], ijk[:, o2], nbits)
-        morder = np.argsort(mk, kind="stable")
-        mk_sorted = mk[morder]
-        for L in np.flatnonzero(present[:depth + 1]):
-            # minus faces of level >= L look for a plus face of level L containing them
-            sel = np.flatnonzero(level >= L)
-            d = level[sel] - L
-            key = _face_keys(minus_plane[sel], np.full(sel.size, L), ijk[sel, o1] >> d, ijk[sel, o2] >> d, nbits)
-            pos = np.searchsorted(pk_sorted, key)
-            pos = np.minimum(pos, pk_sorted.size - 1)
-            hit = pk_sorted[pos] == key
-            pairs.append(np.stack([order[pos[hit]], sel[hit]]))
-            # plus faces of level > L look for a minus face of level L containing them
-            sel = np.flatnonzero(level > L)
-            d = level[sel] - L
-            key = _face_keys(plus_plane[sel], np.full(sel.size, L), ijk[sel, o1] >> d, ijk[sel, o2] >> d, nbits)
-            pos = np.minimum(np.searchsorted(mk_sorted, key), mk_sorted.size - 1)
-            hit = mk_sorted[pos] == key
-            pairs.append(np.stack([sel[hit], morder[pos[hit]]]))
+        for side in (-1, 1):
+            cell = corner.copy()
+            cell[:, ax] = corner[:, ax] - 1 if side < 0 else (ijk[:, ax] + 1) << shift
+            if periodic[ax]:
+                cell[:, ax] %= nfine
+                at = np.arange(n)
+            else:
+                at = np.flatnonzero((cell[:, ax] >= 0) & (cell[:, ax] < nfine))
+            code = _morton(cell[at], depth)
+            pos = np.maximum(np.searchsorted(starts, code, side="right") - 1, 0)
+            other = found_level[pos]
+            not_finer = (other < level[at]) if side < 0 else (other <= level[at])
+            keep = (starts[pos] <= code) & (code < ends[pos]) & not_finer
+            pairs.append(np.stack([at[keep], order[pos[keep]]]))
     p = np.concatenate(pairs, axis=1)
     p = p[:, p[0] != p[1]]
     p = np.sort(p, axis=0)
     if p.size == 0:
         return np.zeros((2, 0), dtype=np.int64)
-    keys = np.sort(p[0] * np.int64(n) + p[1])  # 1-D keys: far faster than unique(axis=1)
+    # a pair may still come twice (a box reaching round a periodic axis both ways): one sorted key each
+    keys = np.sort(p[0] * np.int64(n) + p[1])
     keys = keys[np.concatenate(([True], keys[1:] != keys[:-1]))]
     return np.stack([keys // n, keys % n])
 
@@ -123,13 +117,25 @@ def shares_face_bruteforce(level, ijk, depth: int, periodic=(False, False, True)
     return np.array(out, dtype=np.int64).reshape(-1, 2).T
 
 
+#: Bits per coordinate of a Z-order code (3 x 21 bits fit an int64).
+_MORTON_BITS = 21
+#: Shifts and masks spreading 21 bits to every third bit of 63.
+_SPREAD = ((32, 0x1F00000000FFFF), (16, 0x1F0000FF0000FF), (8, 0x100F00F00F00F00F), (4, 0x10C30C30C30C30C3),
+           (2, 0x1249249249249249))
+
+
+def _spread(v: np.ndarray) -> np.ndarray:
+    x = v & 0x1FFFFF
+    for s, m in _SPREAD:
+        x = (x | (x << s)) & m
+    return x
+
+
 def _morton(ijk: np.ndarray, bits: int) -> np.ndarray:
-    """Z-order codes of integer cells (n, 3) with coordinates below 2**bits (bits <= 20)."""
-    code = np.zeros(ijk.shape[0], dtype=np.int64)
-    for b in range(bits):
-        for ax in range(3):
-            code |= ((ijk[:, ax] >> b) & 1) << (3 * b + ax)
-    return code
+    """Z-order codes of integer cells (n, 3) with coordinates below 2**bits (bits <= 21): bit b of axis a
+    goes to bit 3 b + a."""
+    ijk = np.asarray(ijk, dtype=np.int64)
+    return _spread(ijk[:, 0]) | (_spread(ijk[:, 1]) << 1) | (_spread(ijk[:, 2]) << 2)
 
 
 #: The 26 offsets to the cells around a cell (faces, edges and corners).
