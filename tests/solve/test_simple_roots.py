@@ -80,6 +80,11 @@ def test_ball_operations_enclose_exact_values(mids, rads, ts, k, deriv):
     assert Fraction(float(dot.lo)) <= pa[0] * pb[0] + pa[1] * pb[1] <= Fraction(float(dot.hi))
     mat = a.matmul(Ball(np.array([[mids[2]], [mids[3]]]), np.array([[rads[2]], [rads[3]]]))).to_interval()
     assert Fraction(float(mat.lo[0])) <= pa[0] * pb[0] + pa[1] * pb[1] <= Fraction(float(mat.hi[0]))
+    col = Ball(np.array([[mids[2]], [mids[3]]]), np.array([[rads[2]], [rads[3]]]))
+    stacked = Ball(np.tile(a.mid, (2, 3, 1)), np.tile(a.rad, (2, 3, 1))).matmul(col)  # (2, 3, 1): as one matrix
+    assert stacked.mid.shape == (2, 3, 1) and np.all(stacked.mid == a.matmul(col).mid[0])
+    assert np.all(stacked.rad == a.matmul(col).rad[0])
+    assert Ball(np.zeros((0, 3, 2)), np.zeros((0, 3, 2))).matmul(col).mid.shape == (0, 3, 1)
     rows = Ball(a.mid[None, None, :], a.rad[None, None, :]).row_matmul(
         Ball(np.array([[[mids[2]], [mids[3]]]]), np.array([[[rads[2]], [rads[3]]]]))).to_interval()
     assert Fraction(float(rows.lo[0, 0, 0])) <= pa[0] * pb[0] + pa[1] * pb[1] <= Fraction(float(rows.hi[0, 0, 0]))

@@ -124,6 +124,11 @@ class Ball:
 
     def matmul(self, c: "Ball") -> "Ball":
         """self (..., k) times the matrix c (k, j): a ball (..., j); k <= 64."""
+        if self.mid.ndim > 2 and self.mid.shape == self.rad.shape:
+            # one product of a (rows, k) matrix: numpy's stacked product of a 3-D array is about twice slower
+            flat = Ball(self.mid.reshape(-1, self.mid.shape[-1]), self.rad.reshape(-1, self.rad.shape[-1])).matmul(c)
+            shape = self.mid.shape[:-1] + flat.mid.shape[-1:]
+            return Ball(flat.mid.reshape(shape), flat.rad.reshape(shape))
         am, cm = np.abs(self.mid), np.abs(c.mid)
         m = self.mid @ c.mid
         r = am @ c.rad + self.rad @ (cm + c.rad)

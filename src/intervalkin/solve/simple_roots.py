@@ -71,23 +71,28 @@ _ROWS = 2**14
 _MIN_WIDTH = 2.0**-30
 
 
-def trig_basis(phi: Ball, deriv: int = 0, waves: dict | None = None) -> Ball:
+def trig_basis(phi: Ball, deriv: int = 0, waves: dict | None = None,
+               out: tuple[np.ndarray, np.ndarray] | None = None) -> Ball:
     """(m, 7) balls of the deriv-th phi-derivative of the basis (1, cos phi, sin phi, ...) over phi (m,).
 
     ``waves``: :func:`basis_waves` of ``phi.mid``, when several bases are taken about the same midpoints (the
-    same floats: the same balls, without computing cos and sin again)."""
-    mids, rads = [], []
+    same floats: the same balls, without computing cos and sin again).  ``out``: (mid, rad) arrays (m, 7),
+    possibly views of larger ones, to write the basis into."""
+    mid, rad = (np.empty(phi.mid.shape + (7,)), np.empty(phi.mid.shape + (7,))) if out is None else out
+    col = 0
     for k, is_sin in HARMONICS:
         if k == 0:
-            mids.append(np.full(phi.mid.shape, 1.0 if deriv == 0 else 0.0))
-            rads.append(np.zeros(phi.mid.shape))
+            mid[..., col] = 1.0 if deriv == 0 else 0.0
+            rad[..., col] = 0.0
+            col += 1
             continue
         if is_sin:
             continue
         c, s = cos_sin_multiple(phi, k, deriv, None if waves is None else waves[k])
-        mids += [c.mid, s.mid]
-        rads += [c.rad, s.rad]
-    return Ball(np.stack(mids, axis=-1), np.stack(rads, axis=-1))
+        mid[..., col], mid[..., col + 1] = c.mid, s.mid
+        rad[..., col], rad[..., col + 1] = c.rad, s.rad
+        col += 2
+    return Ball(mid, rad)
 
 
 def basis_waves(mid: np.ndarray) -> dict:
@@ -166,13 +171,13 @@ class ReducedBoxes:
             return Interval(np.concatenate([e.lo for e in parts]), np.concatenate([e.hi for e in parts]))
         piece = Ball.from_interval(Interval(lo, hi))
         waves = basis_waves(piece.mid)
-        bases = [trig_basis(Ball.point(piece.mid), deriv, waves), trig_basis(piece, deriv + 1, waves),
-                 trig_basis(piece, deriv, waves)]
+        bases = Ball(np.empty((len(owner), 3, 7)), np.empty((len(owner), 3, 7)))
+        for slot, (phi, d) in enumerate(((Ball.point(piece.mid), deriv), (piece, deriv + 1), (piece, deriv))):
+            trig_basis(phi, d, waves, (bases.mid[:, slot], bases.rad[:, slot]))
         if self.at_points:
-            at_mid, slope, natural = (w.dot(self.values[owner]) for w in bases)
+            at_mid, slope, natural = (bases[:, i].dot(self.values[owner]) for i in range(3))
         else:
-            both = self._over_r(owner, Ball(np.stack([w.mid for w in bases], axis=1),
-                                            np.stack([w.rad for w in bases], axis=1)))  # (m, 3)
+            both = self._over_r(owner, bases)  # (m, 3)
             at_mid, slope, natural = (both[:, i] for i in range(3))
         mv = (at_mid + slope * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval()
         return mv.intersect(natural.to_interval())
