@@ -28,7 +28,7 @@ from intervalkin.solve.dkp import parse_joint_vector, solve
 from intervalkin.core.geometry import load_geometry
 from intervalkin.space.trajectory import trajectory
 
-from ..conftest import DATA, small_chain
+from ..conftest import DATA
 
 TABLE1 = ["14.98", "15.38", "12.0"]
 
@@ -39,9 +39,10 @@ def table1(paper_geometry):
 
 
 @pytest.fixture(scope="module")
-def chain(paper_geometry):
-    """A small real chain (about 15 s): workspace depth 7, joint grid 2**5, regions at depth 7."""
-    return small_chain(paper_geometry, 7, 5, 7)
+def chain(regions_chain):
+    """A small real chain: workspace depth 7, joint grid 2**6, regions at depth 7 (tests/conftest.py, built once a
+    run for the region tests too)."""
+    return regions_chain
 
 
 @pytest.fixture(scope="module")
