@@ -144,8 +144,7 @@ class ReducedBoxes:
                              np.ascontiguousarray(self.taylor.rad.transpose(0, 2, 1)))
         # second-order part, sum_h w_h Q_h(d): the quadratic coefficients as rows (6, 7), d-bounds per box
         quad = [m for m, e in enumerate(MONOMIALS) if len(e) == 2]
-        self.quad_rows = Ball(C.mid[:, quad].T.copy(), C.rad[:, quad].T.copy())  # (6, 7)
-        self.quad_t = Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy())  # (7, 6)
+        self.quad_t = Ball(C.mid[:, quad].copy(), C.rad[:, quad].copy())  # (7, 6): basis index, monomial
         h = self.half
         self.quad_square = np.array([MONOMIALS[m][0] == MONOMIALS[m][1] for m in quad])
         self.quad_bound = np.stack([h[:, MONOMIALS[m][0]] * h[:, MONOMIALS[m][1]] for m in quad], axis=1) * (1.0 + 2.0**-40)
@@ -209,7 +208,7 @@ class ReducedBoxes:
         half = self.half[owner]
         w = trig_basis(Ball.from_interval(Interval(lo, hi)), deriv)
         t = w.dot_rows(taylor)  # (m, 4)
-        q = w.matmul(Ball(self.quad_rows.mid.T.copy(), self.quad_rows.rad.T.copy()))  # (m, 6)
+        q = w.matmul(self.quad_t)  # (m, 6)
         quad = [e for e in MONOMIALS if len(e) == 2]
         spread = np.zeros(len(owner))
         for i in range(3):
