@@ -31,7 +31,7 @@ import numpy as np
 
 # the VTK writers live in vtk_export (meshio); the command handlers import them from here
 from intervalkin.app.vtk_export import read_vtu, write_vtu_paving
-from intervalkin.core.files import atomic_write
+from intervalkin.core.files import atomic_write, write_npz_columns
 from intervalkin.paving.labels import signed_labels
 from intervalkin.paving.tree import Paving
 
@@ -66,7 +66,7 @@ def write_npz(path, paving: Paving, aspect=None, extra=None) -> Path:
     """Write ``pavings/workspace.npz`` (compressed) with the documented columns plus ``extra``."""
     cols = paving_columns(paving, aspect, extra)
     cols["domain"] = np.asarray(paving.domain, dtype=np.float64)
-    return atomic_write(Path(path), lambda f: np.savez_compressed(f, **cols))
+    return atomic_write(Path(path), lambda f: write_npz_columns(f, cols))
 
 
 def read_npz(path) -> dict[str, np.ndarray]:

@@ -43,7 +43,7 @@ from intervalkin.app.summary import chain_summary
 from intervalkin.app.table1 import TABLE1_RHO
 from intervalkin.app.vtk_export import write_region_exports
 from intervalkin.core.errors import InputError, IntervalkinError
-from intervalkin.core.files import atomic_write_bytes, watching_writes, write_json
+from intervalkin.core.files import atomic_write_bytes, watching_writes, write_json, write_npz_columns
 from intervalkin.core.version import __version__
 from intervalkin.pipeline import Analysis
 from intervalkin.solve.dkp import parse_joint_vector, solve
@@ -262,7 +262,7 @@ def write_chain(a: Analysis, out: Path, figures: bool = True, stages: Stages | N
 def npz_bytes(cols: dict) -> bytes:
     """A compressed npz file of named columns, as bytes (for an atomic write)."""
     buf = io.BytesIO()
-    np.savez_compressed(buf, **cols)
+    write_npz_columns(buf, cols)
     return buf.getvalue()
 
 

@@ -132,8 +132,6 @@ import dataclasses
 from pathlib import Path
 from typing import Sequence
 
-import numpy as np
-
 from intervalkin.certify.aspect_claims import aspect_connected_claims
 from intervalkin.certify.joint_claims import joint_claims
 from intervalkin.certify.separation_claims import pattern_barriers, separation_claims
@@ -150,7 +148,7 @@ from intervalkin.certify.workspace_claims import (
 )
 from intervalkin.checker import FORMAT, INDEX, KINDS, VERSION
 from intervalkin.core.errors import InputError
-from intervalkin.core.files import atomic_write, write_json
+from intervalkin.core.files import atomic_write, write_json, write_npz_columns
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Beside
 from intervalkin.core.version import __version__
@@ -287,7 +285,7 @@ def write_certificates(
         beside = [write_json(out / SEPARATION_JSON, {
             "format": FORMAT, "version": VERSION, "kind": "joint_separation", "geometry_toml": toml,
             "claims": barriers[0]}, indent=1),
-            atomic_write(out / SEPARATION_NPZ, lambda fh: np.savez_compressed(fh, **barriers[1]))]
+            atomic_write(out / SEPARATION_NPZ, lambda fh: write_npz_columns(fh, barriers[1]))]
     index = {
         "format": FORMAT,
         "version": VERSION,

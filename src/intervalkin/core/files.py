@@ -21,11 +21,18 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+import zipfile
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any, Callable, Iterator
 
-__all__ = ['atomic_write', 'atomic_write_bytes', 'write_json', 'watching_writes']
+import numpy as np
+
+__all__ = ['atomic_write', 'atomic_write_bytes', 'write_json', 'watching_writes', 'write_npz_columns', 'NPZ_LEVEL']
+
+#: zlib level of the npz files: 1 writes the pavings about four times faster than numpy's ``savez_compressed``
+#: (level 6), for files about a fifth larger (the paper run's workspace paving: 4.0 s -> 0.9 s, 16 -> 20 MB).
+NPZ_LEVEL = 1
 
 #: Callbacks told of each destination before it is replaced (see :func:`watching_writes`).
 _watchers: list[Callable[[Path], None]] = []
@@ -85,3 +92,12 @@ def write_json(path, obj, indent: int = 2) -> Path:
     """Write ``obj`` as JSON (``indent`` spaces, trailing newline, no NaN), atomically; returns the path."""
     data = (json.dumps(obj, indent=indent, allow_nan=False) + "\n").encode()
     return atomic_write_bytes(path, data)
+
+
+def write_npz_columns(fh: IO[bytes], cols: dict) -> None:
+    """Named arrays into an open binary file as a compressed npz (one ``name.npy`` member each, what
+    :func:`numpy.load` reads), deflated at :data:`NPZ_LEVEL`; no pickled objects."""
+    with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=NPZ_LEVEL) as z:
+        for name, value in cols.items():
+            with z.open(f"{name}.npy", "w", force_zip64=True) as member:
+                np.lib.format.write_array(member, np.asanyarray(value), allow_pickle=False)
