@@ -59,11 +59,7 @@ def shares_face(level: np.ndarray, ijk: np.ndarray, depth: int, periodic=(False,
     nfine = np.int64(1) << depth
     shift = depth - level
     corner = ijk << shift[:, None]
-    start = _morton(corner, depth)
-    order = np.argsort(start, kind="stable")
-    starts = start[order]
-    ends = starts + (np.int64(1) << (3 * shift[order]))  # a box holds the codes [start, end)
-    found_level = level[order]
+    holder = _cell_holders(level, ijk, depth)
     pairs = []
     for ax in range(3):
         for side in (-1, 1):
@@ -74,12 +70,11 @@ def shares_face(level: np.ndarray, ijk: np.ndarray, depth: int, periodic=(False,
                 at = np.arange(n)
             else:
                 at = np.flatnonzero((cell[:, ax] >= 0) & (cell[:, ax] < nfine))
-            code = _morton(cell[at], depth)
-            pos = np.maximum(np.searchsorted(starts, code, side="right") - 1, 0)
-            other = found_level[pos]
+            found = holder(cell[at])
+            other = level[np.maximum(found, 0)]
             not_finer = (other < level[at]) if side < 0 else (other <= level[at])
-            keep = (starts[pos] <= code) & (code < ends[pos]) & not_finer
-            pairs.append(np.stack([at[keep], order[pos[keep]]]))
+            keep = (found >= 0) & not_finer
+            pairs.append(np.stack([at[keep], found[keep]]))
     p = np.concatenate(pairs, axis=1)
     p = p[:, p[0] != p[1]]
     p = np.sort(p, axis=0)
@@ -138,6 +133,25 @@ def _morton(ijk: np.ndarray, bits: int) -> np.ndarray:
     return _spread(ijk[:, 0]) | (_spread(ijk[:, 1]) << 1) | (_spread(ijk[:, 2]) << 2)
 
 
+def _cell_holders(level: np.ndarray, ijk: np.ndarray, depth: int):
+    """For boxes (level, ijk) tiling part of the domain: a function mapping finest cells (m, 3) to the box holding
+    each (-1 where none, a gap).  The boxes sorted by the Z-order code of their lowest finest cell hold the codes
+    [start, start + 8^(depth - level)), disjoint ranges: the holder of a code is the last box starting at or
+    before it, when the code lies in its range."""
+    shift = depth - level
+    start = _morton(ijk << shift[:, None], depth)
+    order = np.argsort(start, kind="stable")
+    starts = start[order]
+    ends = starts + (np.int64(1) << (3 * shift[order]))
+
+    def holder(cells: np.ndarray) -> np.ndarray:
+        code = _morton(cells, depth)
+        pos = np.maximum(np.searchsorted(starts, code, side="right") - 1, 0)
+        return np.where((starts[pos] <= code) & (code < ends[pos]), order[pos], -1)
+
+    return holder
+
+
 #: The 26 offsets to the cells around a cell (faces, edges and corners).
 _AROUND = np.array([(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)],
                    dtype=np.int64)
@@ -156,7 +170,7 @@ def touching_pairs(level: np.ndarray, ijk: np.ndarray, depth: int, mask: np.ndar
     level for one of the 26 offsets d (per axis: the intervals overlap, d = 0, or touch, d = +-1),
     hence the fine cell of f + d nearest to f; so each box looks up, for each offset, the box
     holding that fine cell (one sorted search of Z-order codes; every box found does meet f: it
-    holds a fine cell touching f).  Cost: 26 sorted searches per selected box.  depth <= 20.
+    holds a fine cell touching f; :func:`_cell_holders`).  Cost: 26 sorted searches per selected box.  depth <= 20.
     """
     level = np.asarray(level, dtype=np.int64)
     ijk = np.asarray(ijk, dtype=np.int64)
@@ -167,9 +181,7 @@ def touching_pairs(level: np.ndarray, ijk: np.ndarray, depth: int, mask: np.ndar
     if n == 0 or not np.any(mask):
         return np.zeros((2, 0), dtype=np.int64)
     shift = depth - level
-    start = _morton(ijk << shift[:, None], depth)
-    order = np.argsort(start, kind="stable")
-    starts = start[order]
+    holder = _cell_holders(level, ijk, depth)
     sel = np.flatnonzero(mask)
     nfine = np.int64(1) << depth
     rows = []
@@ -185,8 +197,8 @@ def touching_pairs(level: np.ndarray, ijk: np.ndarray, depth: int, mask: np.ndar
         s = shift[sel][:, None]
         fine = (c << s) + np.where(d < 0, (np.int64(1) << s) - 1, 0)  # the fine cell of c nearest to the box
         fine = np.clip(fine, 0, nfine - 1)
-        found = order[np.searchsorted(starts, _morton(fine, depth), side="right") - 1]
-        keep &= mask[found] & (found != sel)
+        found = holder(fine)
+        keep &= (found >= 0) & mask[found] & (found != sel)
         rows.append(np.stack([sel[keep], found[keep]]))
     p = np.sort(np.concatenate(rows, axis=1), axis=0)
     if p.size == 0:
