@@ -92,7 +92,10 @@ def test_count_barriers_are_reported_beside_the_separations():
     # 2 components of 4 solutions, 1 of 2: Theorem 1 puts 2 * 4 + 1 * 2 basic regions above them
     assert got["basic_regions_at_least"] == 2 * 4 + 2
     assert got["pattern_barrier_cells"] == [3] and got["count_barrier_cells"] == [6, 7]
-    assert summary["basic_regions"]["barriers_at_least"] == 10 and "re-proved by" in summary["basic_regions"]["why"]
+    block = summary["basic_regions"]
+    assert block["barriers_at_least"] == 10 and "re-proved by" in block["why"]
+    # the certified lower bound is the raised one, the claim's own kept beside it
+    assert block["lower_bound"] == 10 and block["counts_claim_lower"] == 6 and block["exact"] is False
     empty = {"joint_cells": {"separations": {"by_signature": []}}}
     add_barrier_certificates(empty, [])
     assert "count_barriers" not in empty["joint_cells"]["separations"]

@@ -53,6 +53,23 @@ def test_summary_blocks_that_agree_or_cannot_be_compared():
         check_summary_block("basic_regions", CLAIM, 12, {"unreadable": "summary.json cannot be read (x)"})
 
 
+def test_a_lower_bound_raised_by_barriers_is_accepted_only_as_their_number():
+    """The summary's basic-region bound may stand above the claim's only as barriers_at_least (which the recheck's
+    barrier_bound verdict re-proves), with the claim's own bound beside it as counts_claim_lower."""
+    raised = {**BLOCK, "lower_bound": 14, "barriers_at_least": 14, "counts_claim_lower": 12}
+    text = check_summary_block("basic_regions", CLAIM, 12, {"basic_regions": raised})
+    assert "lower bound 14: the claim's 12 raised by the count and pattern barriers" in text
+    for edit, why in (({"lower_bound": 16}, "lower_bound 16 but the claim declares 12"),
+                      ({"counts_claim_lower": 10}, "counts_claim_lower 10 is not the claim's lower_bound 12"),
+                      ({"counts_claim_lower": None}, "is not the claim's lower_bound")):
+        with pytest.raises(Refused, match="contradicts|counts_claim_lower") as exc:
+            check_summary_block("basic_regions", CLAIM, 12, {"basic_regions": {**raised, **edit}})
+        assert why in str(exc.value)
+    # another count cannot borrow the basic regions' barriers
+    with pytest.raises(Refused, match="lower_bound 14 but the claim declares 12"):
+        check_summary_block("aspects", {**CLAIM, "name": "aspects"}, 12, {"aspects": raised})
+
+
 def test_only_a_certificates_folder_reads_the_summary_beside_it(tmp_path):
     (tmp_path / "certificates").mkdir()
     (tmp_path / "summary.json").write_text('{"complete": true}')

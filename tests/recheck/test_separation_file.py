@@ -257,6 +257,11 @@ def test_the_summary_bound_of_the_barriers_is_checked(built, paper_geometry, tmp
         write_json(tmp_path / "summary.json", {"basic_regions": {"barriers_at_least": stated}})
         last = recheck_separations(tmp_path)[-1]
         assert last.kind == "barrier_bound" and last.verified is ok, last.line()
+    # a bound stated from barriers with the barrier file gone is refused, not passed over
+    (tmp_path / CLAIMS).unlink()
+    write_json(tmp_path / "summary.json", {"basic_regions": {"barriers_at_least": 14}})
+    got = recheck_separations(tmp_path)
+    assert [r.kind for r in got] == ["barrier_bound"] and not got[0].verified, got[0].line()
 
 
 def test_a_folder_with_a_pattern_barrier_verifies_and_a_torn_tie_is_refused(every, paper_geometry, tmp_path):

@@ -5,7 +5,8 @@ A ``counts`` claim carries the library's number ``found`` beside its declared
 prove (:func:`~intervalkin.checker.claims.count_bound`).  Whatever the run
 printed, these must hold, and :func:`check_found` refuses the claim otherwise:
 
-* ``lower_bound <= proved`` (the declared bound is backed; checked in ``claims``);
+* ``lower_bound <= proved`` (the declared bound is backed; checked in ``claims``); the summary's basic-region
+  bound may instead be ``barriers_at_least``, which the recheck's ``barrier_bound`` verdict backs;
 * ``found >= proved``: a number of pieces found below a proved minimum is a
   contradiction (the pieces were miscounted, or a proof is wrong), never a
   result to print; likewise ``found <= proved upper bound`` when one is proved.
@@ -104,7 +105,8 @@ def check_summary_block(name: str, claim: dict, proved: int, summary: dict | Non
     problems = []
     if claim.get("found") is not None and count != claim.get("found"):
         problems.append(f"count {count} but the claim says {claim.get('found')} found")
-    if lower != claim.get("lower_bound"):
+    raised = _barrier_raise(name, block, claim, lower)
+    if lower != claim.get("lower_bound") and not raised:
         problems.append(f"lower_bound {lower} but the claim declares {claim.get('lower_bound')}")
     if count < lower:
         problems.append(f"count {count} below its own lower_bound {lower}")
@@ -122,4 +124,23 @@ def check_summary_block(name: str, claim: dict, proved: int, summary: dict | Non
         raise Refused(f"{SUMMARY} contradicts the certificates on {name}: " + "; ".join(problems))
     bounds = f"lower bound {lower}" + ("" if upper is None else f", upper bound {upper}, exact" if exact
                                        else f", upper bound {upper}")
+    if raised:
+        bounds += (f": the claim's {claim.get('lower_bound')} raised by the count and pattern barriers, which the "
+                   "barrier_bound verdict of the same verify run re-proves")
     return f"; {SUMMARY} agrees (count {count}, {bounds})"
+
+
+def _barrier_raise(name: str, block: dict, claim: dict, lower: int) -> bool:
+    """Whether the summary's basic-region ``lower_bound`` is the claim's raised by the separation barriers.
+
+    Only one number may stand above the claim's: ``barriers_at_least``, beside ``counts_claim_lower`` equal to
+    the claim's bound.  This checker does not re-prove it (the barriers are the numpy recheck's,
+    ``recheck.separation_file.barrier_bound``); ``intervalkin verify`` runs that verdict whenever the summary
+    states ``barriers_at_least``, so the bound holds exactly when both verdicts pass."""
+    if name != "basic_regions" or block.get("barriers_at_least") is None:
+        return False
+    declared = claim.get("lower_bound")
+    if block.get("counts_claim_lower") != declared or not isinstance(declared, int):
+        raise Refused(f"{SUMMARY} basic_regions states barriers_at_least but its counts_claim_lower "
+                      f"{block.get('counts_claim_lower')!r} is not the claim's lower_bound {declared!r}")
+    return lower == block["barriers_at_least"] and lower > declared

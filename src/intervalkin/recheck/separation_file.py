@@ -267,12 +267,16 @@ def _read(folder: Path) -> tuple[dict, dict[str, np.ndarray]]:
 
 def recheck_separations(folder: str | Path) -> list[CheckResult]:
     """One verdict per separation claim of the output folder (given as the folder or its ``certificates/``);
-    [] when it has none.  Raises :class:`CertificateFormatError` for unreadable or malformed files."""
+    [] when it has none, plus the ``barrier_bound`` verdict when ``summary.json`` states a bound from barriers
+    (also when there are no claims: then it is refused unless it is the counts claim's own).  Raises
+    :class:`CertificateFormatError` for unreadable or malformed files."""
     root = Path(folder)
     if root.name == "certificates" and not (root / CLAIMS).is_file():
         root = root.parent
     if not (root / CLAIMS).is_file():
-        return []
+        # a summary may still state a bound from barriers: with no claims to back it, the verdict refuses it
+        bound = _summary_bound(root, [], [])
+        return [] if bound is None else [bound]
     doc, arrays = _read(root)
     geometry = folder_geometry(root / "pavings" / "workspace.npz")
     out = []
