@@ -228,14 +228,16 @@ class Analysis:
                              f"{where}; the solve at rho was not completed ({res.completeness_reason})")
 
     def write_certificates(self, folder: str | Path, dkp_results: Sequence[dkp.DkpResult] = (),
-                           trajectories: Sequence = ()) -> list[Path]:
+                           trajectories: Sequence = (), barrier_faces: int | None = None) -> list[Path]:
         """Write the certificate folder of this analysis (and of extra solves and paths); return its files.
 
+        ``barrier_faces``: faces the pattern barriers may range (None: the default budget).
         :func:`verify` re-proves every claim from the files alone.
         """
+        extra = {} if barrier_faces is None else {"barrier_faces": barrier_faces}
         return write_certificates(folder, self.geometry, dkp_results=dkp_results, joint=self.joint,
                                   regions=self.regions, trajectories=trajectories, counts=self.counts(),
-                                  aspect_topology=self.aspect_topology, joint_cells=self.cells)
+                                  aspect_topology=self.aspect_topology, joint_cells=self.cells, **extra)
 
 
 @dataclass(frozen=True)

@@ -214,6 +214,48 @@ def test_depths_outside_the_range_are_refused_before_any_work(command, tmp_path,
 
 
 @pytest.mark.parametrize("command", ["analyze", "paper"])
+def test_a_barrier_face_budget_out_of_range_is_refused_at_once(command, tmp_path, refused):
+    out = tmp_path / "out"
+    for n in ("-1", "4000001"):
+        refused([command, "--barrier-faces", n, "--out", str(out)], "--barrier-faces")
+    refused([command, "--barrier-faces", "many", "--out", str(out)], "--barrier-faces", usage=True)
+
+
+def test_the_barrier_face_budget_reaches_the_pattern_floods(monkeypatch, tmp_path):
+    """--barrier-faces goes from the command line through the analysis's certificate writer to the process that
+    runs the pattern floods (each hop recorded, nothing computed)."""
+    from types import SimpleNamespace
+
+    import intervalkin.app.cli as cli
+    import intervalkin.certify.writer as writer
+    import intervalkin.pipeline as pipeline
+    from intervalkin.app.output import write_analysis_certificates
+    from intervalkin.core.geometry import default_geometry
+
+    seen = {}
+    monkeypatch.setattr(cli, "run_analyze", lambda *a, **k: seen.setdefault("cli", k["barrier_faces"]) and 0)
+    main(["paper", "--barrier-faces", "1234", "--out", str(tmp_path / "o")])
+
+    class Stop(Exception):
+        pass
+
+    def beside(fn, *args):
+        seen["beside"] = (fn.__name__, args[-1])
+        raise Stop
+
+    monkeypatch.setattr(writer, "Beside", beside)
+    with pytest.raises(Stop):
+        writer.write_certificates(tmp_path / "c", default_geometry(), joint_cells=object(), barrier_faces=77)
+    monkeypatch.setattr(pipeline, "write_certificates", lambda *a, **k: seen.setdefault("pipeline", k) and [])
+    a = SimpleNamespace(geometry=SimpleNamespace(name="x"), joint=None, regions=None, counts=lambda: None,
+                        aspect_topology=None, cells=None)
+    a.write_certificates = lambda *x, **k: pipeline.Analysis.write_certificates(a, *x, **k)
+    write_analysis_certificates(a, tmp_path, barrier_faces=55)
+    assert seen["cli"] == 1234 and seen["beside"] == ("pattern_barriers", 77)
+    assert seen["pipeline"]["barrier_faces"] == 55
+
+
+@pytest.mark.parametrize("command", ["analyze", "paper"])
 def test_refine_to_out_of_range_is_refused_at_once(command, tmp_path, refused):
     out = tmp_path / "out"
     refused([command, "--refine-to", "30", "--out", str(out)], "refine_to")

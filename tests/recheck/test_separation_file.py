@@ -207,6 +207,18 @@ def test_a_swapped_pattern_witness_is_refused(patterned, paper_geometry):
         check_pattern_separation(paper_geometry, swapped, region, patterns, barrier, box, outer)
 
 
+def test_the_face_budget_bounds_the_pattern_floods(fold_paving, paper_geometry, every):
+    """--barrier-faces is the floods' budget for the whole paving: with none left no cell is tried, and each cell
+    left out says so; with the default the paper paving's barrier is made (``every``)."""
+    from intervalkin.certify.separation_claims import pattern_barriers
+
+    made, omitted = pattern_barriers(fold_paving, paper_geometry, budget=0)
+    assert made == [] and omitted
+    assert all("--barrier-faces 0" in o["why"] for o in omitted if "boxes of the paving" in o["why"])
+    assert any("--barrier-faces 0" in o["why"] for o in omitted)
+    assert any(c.get("kind") == "pattern" for c in every[0])
+
+
 def test_the_folder_is_read_and_a_corrupt_file_is_a_format_error(built, paper_geometry, tmp_path):
     claims, arrays, _ = built
     cert = tmp_path / "certificates"

@@ -21,7 +21,7 @@ from pathlib import Path
 from intervalkin.app.animation import write_trajectory
 from intervalkin.app.export import paving_columns, write_npz, write_vtu_paving
 from intervalkin.app.figures import render_all, render_joint
-from intervalkin.app.options import check_joint_depth, geometry_from_option
+from intervalkin.app.options import check_barrier_faces, check_joint_depth, geometry_from_option
 from intervalkin.app.output import (
     OutputFolder,
     npz_bytes,
@@ -144,10 +144,13 @@ def run_joint(geometry_path, depth: int, out, force: bool = False, quiet: bool =
 
 def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool = False, as_json: bool = False,
                 figures: bool = True, certificates: bool = True, paper: bool = False,
-                refine_to: int | None = None) -> int:
-    """``intervalkin analyze`` (and ``paper`` when paper=True): the whole chain into one folder."""
+                refine_to: int | None = None, barrier_faces: int | None = None) -> int:
+    """``intervalkin analyze`` (and ``paper`` when paper=True): the whole chain into one folder.
+    ``barrier_faces``: the pattern barriers' face budget (None: the default)."""
     geometry = default_geometry() if paper else geometry_from_option(geometry_path)
     check_chain_depth(depth, refine_to)  # before the output folder is made
+    if barrier_faces is not None:
+        check_barrier_faces(barrier_faces)
     folder = OutputFolder.open(out, force, "paper" if paper else "analyze")
     out = folder.root
     st = Stages(quiet=quiet or as_json)
@@ -177,7 +180,7 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
             summary["trajectories"], trajs = early["trajectories"]
         if certificates:
             st.start("certificates")
-            summary["files"] += write_analysis_certificates(a, out, trajectories=trajs)
+            summary["files"] += write_analysis_certificates(a, out, trajectories=trajs, barrier_faces=barrier_faces)
             if (out / "certificates" / "joint_separation.json").is_file():
                 barriers = json.loads((out / "certificates" / "joint_separation.json").read_text(encoding="utf-8"))
                 add_barrier_certificates(summary, barriers["claims"])

@@ -30,6 +30,20 @@ def depth_help(what: str, depths: tuple[int, int], default: int) -> str:
     return f"{what}, {depths[0]}..{depths[1]} (default {default})"
 
 
+#: ``analyze``/``paper --barrier-faces``: faces the pattern barriers may relate in all (certify.separation_claims).
+BARRIER_FACES = (0, 4_000_000)
+
+
+def check_barrier_faces(n) -> int:
+    """``--barrier-faces``: an integer in BARRIER_FACES, else :class:`InputError` naming the flag.  The upper end
+    keeps a run to hours (about 5 ms per face) and the flood's tables to a few GB."""
+    lo, hi = BARRIER_FACES
+    if isinstance(n, bool) or not isinstance(n, int) or not lo <= n <= hi:
+        raise InputError(f"--barrier-faces: expected an integer in {lo}..{hi} (faces the pattern barriers may "
+                         f"relate), got {n!r}")
+    return n
+
+
 def check_joint_depth(depth) -> int:
     """``joint --depth``: an integer in JOINT_DEPTHS, else :class:`InputError` naming the flag."""
     lo, hi = JOINT_DEPTHS

@@ -266,7 +266,7 @@ def npz_bytes(cols: dict) -> bytes:
     return buf.getvalue()
 
 
-def write_analysis_certificates(a: Analysis, out: Path, trajectories=()) -> list[str]:
+def write_analysis_certificates(a: Analysis, out: Path, trajectories=(), barrier_faces: int | None = None) -> list[str]:
     """Write ``out/certificates`` for an analysis; returns the file names relative to ``out``.
 
     On the paper's manipulator the certified solve of Table 1 is certified too;
@@ -276,5 +276,6 @@ def write_analysis_certificates(a: Analysis, out: Path, trajectories=()) -> list
     dkp_results = []
     if a.geometry.name == "Wenger-Chablat 1997":
         dkp_results.append(solve(a.geometry, parse_joint_vector(a.geometry, TABLE1_RHO)))
-    paths = a.write_certificates(out / "certificates", dkp_results=dkp_results, trajectories=trajectories)
+    paths = a.write_certificates(out / "certificates", dkp_results=dkp_results, trajectories=trajectories,
+                                 barrier_faces=barrier_faces)
     return [f"certificates/{Path(p).name}" for p in paths]

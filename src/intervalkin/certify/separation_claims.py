@@ -63,10 +63,10 @@ SHRINK = 0.6
 SAMPLE, MAX_FAIL_SHARE = 200, 0.35
 #: Faces worth sending to a second process at once.
 MIN_PART = 400
-#: Faces a pattern barrier's flood may range, for one flood and for all of one paving's floods (a face needs a
-#: range only where its boxes' own patterns would carry the flood across it): the second design's first barrier
-#: ranges 9761, the paper's 3042.
-PATTERN_BUDGET, TOTAL_PATTERN_BUDGET = 16000, 16000
+#: Faces the pattern barriers' floods may range for all of one paving, by default (``--barrier-faces``; a face
+#: needs a range only where its boxes' own patterns would carry the flood across it): the second design's first
+#: barrier ranges 9761, the paper's 3042; a 4-solution cell of limits [10.5, 32] 115 320 (about 9 minutes).
+PATTERN_BUDGET = 16000
 #: Faces a flood ranges per box of its cell, at least: the floods that closed ranged 9 and 15 (a region holds its
 #: whole cell and spreads to about five times its boxes).  A cell past the budget at this rate is not tried.
 FACES_PER_BOX = 12
@@ -186,7 +186,7 @@ def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
                      budget: int = PATTERN_BUDGET) -> tuple[list[tuple[dict, list[dict], PatternBarrier]], list[dict]]:
     """Pattern barriers (:mod:`intervalkin.certify.pattern_barriers`) for the cells with solutions whose signature
     two cells or more share: for a signature with k cells, barriers are tried cell by cell, smallest first, until
-    k - 1 are found (enough to tell every pair apart).  Returns (witness, other witnesses (with ``cell``),
+    k - 1 are found (enough to tell every pair apart) or ``budget`` faces are ranged in all.  Returns (witness, other witnesses (with ``cell``),
     barrier, cell, signature) per barrier and what was left out."""
     p = jp.paving
     out, omitted = [], []
@@ -231,24 +231,29 @@ def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
         ready = sorted((c for c in mine if pats.get(c.id) is not None), key=lambda c: boxes[c.id])
         made = 0
         for c in ready:
-            if made == len(mine) - 1 or spent >= TOTAL_PATTERN_BUDGET:
+            if made == len(mine) - 1:
                 break
+            if spent >= budget:
+                omitted.append({"what": f"pattern barrier of cell {c.id} ({sig[0]} solutions)",
+                                "why": f"no face budget left ({spent} ranged of --barrier-faces {budget})"})
+                continue
             others = [o for o in mine if o.id != c.id]
             if any(o.id not in ends or pats[o.id] is None for o in others):
                 omitted.append({"what": f"pattern barrier of cell {c.id}",
                                 "why": "another cell's witness has no pattern"})
                 continue
-            if boxes[c.id] * FACES_PER_BOX > min(budget, TOTAL_PATTERN_BUDGET - spent):
+            if boxes[c.id] * FACES_PER_BOX > budget - spent:
                 # the region holds the whole cell, and each box brings at least FACES_PER_BOX faces: it cannot close
                 omitted.append({"what": f"pattern barrier of cell {c.id} ({sig[0]} solutions)",
-                                "why": f"the cell alone is {boxes[c.id]} boxes of the paving, past the face budget"})
+                                "why": f"the cell alone is {boxes[c.id]} boxes of the paving, past the face budget "
+                                       f"left ({budget - spent} of --barrier-faces {budget})"})
                 continue
             forbidden = {node[o.id]: {pats[o.id]} for o in others}
             rivals = np.unique(owner[np.isin(jp.cell, [o.id for o in others])])
             # a clear box of another count is walled where its count ranges say so: its arcs may be too coarse to
             walls = (clear_count >= 0) & (clear_count != sig[0])
             bar, why, used = flood(geometry, lo, hi, a, b, sig[0], (node[c.id], pats[c.id]), forbidden, rivals,
-                                   budget=min(budget, TOTAL_PATTERN_BUDGET - spent), walls=walls,
+                                   budget=budget - spent, walls=walls,
                                    same=clear_count == sig[0])
             spent += used
             if bar is None:
