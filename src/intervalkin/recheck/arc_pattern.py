@@ -52,6 +52,10 @@ FACE_DEPTH = 9
 #: (:func:`split_excludes`), tried in this order.  The whole face (1) proved none that 2 x 2 did not, in the
 #: floods of the paper's depth-5 paving and of the second design.
 SPLITS = (2, 4)
+#: Boxes (or faces) whose arcs (or relations) are computed at once: the interval evaluations hold about 64 grid
+#: angles and their bisection pieces per row, so a batch of 67 000 boxes (a 4-solution cell's barrier) took
+#: 13.7 GB in one piece.
+BLOCK = 2048
 
 
 def arc_starts(mask: np.ndarray) -> np.ndarray:
@@ -165,9 +169,15 @@ class BoxArcs:
 
 
 def box_arcs(k: ReducedConstants, q_lo: np.ndarray, q_hi: np.ndarray, grid: int = GRID) -> BoxArcs:
-    """The cuts and arcs of each joint box [q_lo[i], q_hi[i]] (every candidate angle with a proved sign is a cut)."""
+    """The cuts and arcs of each joint box [q_lo[i], q_hi[i]] (every candidate angle with a proved sign is a cut).
+
+    Each box's arcs depend on that box alone: long batches are taken in blocks of :data:`BLOCK` boxes, the same
+    results in a bounded memory."""
     q_lo, q_hi = np.atleast_2d(q_lo), np.atleast_2d(q_hi)
     n = q_lo.shape[0]
+    if n > BLOCK:
+        parts = [box_arcs(k, q_lo[i:i + BLOCK], q_hi[i:i + BLOCK], grid) for i in range(0, n, BLOCK)]
+        return BoxArcs(*(np.concatenate([getattr(x, f) for x in parts]) for f in FIELDS))
     signs = cut_signs(k, q_lo, q_hi, grid)
     t = arc_table(k, q_lo, q_hi, signs, grid)
     end, lo, hi, parity = (np.full((n, grid), -9, dtype=np.int64) for _ in range(4))
@@ -241,9 +251,16 @@ def face_relations(k: ReducedConstants, f_lo: np.ndarray, f_hi: np.ndarray, a: B
 
     The refined arcs are those of the union of both boxes' cuts.  A refined arc's range is the meet of what
     each box proves (its own arc's range when the arcs coincide, else the upper bound of the arc holding it)
-    and, where that is not exact, of :func:`~intervalkin.recheck.count_range.arc_ranges` over F_i."""
+    and, where that is not exact, of :func:`~intervalkin.recheck.count_range.arc_ranges` over F_i.  Faces are
+    taken in blocks of :data:`BLOCK` (each face's relation depends on its own row alone)."""
     f_lo, f_hi = np.atleast_2d(f_lo), np.atleast_2d(f_hi)
     m = f_lo.shape[0]
+    if m > BLOCK:
+        out: list[set[tuple[tuple, tuple]]] = []
+        for i in range(0, m, BLOCK):
+            rows = np.arange(i, min(m, i + BLOCK))
+            out += face_relations(k, f_lo[rows], f_hi[rows], a.take(rows), b.take(rows), count, grid)
+        return out
     r_lo, r_hi = r_box(f_lo, f_hi)
     ang = cut_angles(grid)
     signs = np.where(a.signs != 0, a.signs, b.signs)
