@@ -292,3 +292,28 @@ def test_a_folder_with_a_pattern_barrier_verifies_and_a_torn_tie_is_refused(ever
     got = recheck_separations(tmp_path)[j]
     assert not got.verified and "barrier_box" in got.message
 
+
+
+def test_a_leaking_flood_names_where_it_leaks(fold_paving, paper_geometry, monkeypatch):
+    """A flood given up because its patterns reach another cell's boxes says where (the boxes it reached), the
+    place a finer paving would be needed: here a clear leaf's neighbour of the same cell is called a rival."""
+    import intervalkin.certify.pattern_barriers as pb
+    from intervalkin.paving.adjacency import shares_face
+    from intervalkin.paving.tree import box_bounds
+    from intervalkin.recheck.arc_pattern import own_patterns
+
+    p, cell = fold_paving.paving, fold_paving.cell
+    lo, hi = box_bounds(p.domain, p.level, p.ijk)
+    a, b = shares_face(p.level, p.ijk, int(p.level.max()), periodic=(False, False, False))
+    k = reduced_constants(paper_geometry)
+    counts = {c.id: c.signature[0] for c in fold_paving.cells}
+    pair = next((x, y) for x, y in zip(a.tolist(), b.tolist())
+                if cell[x] >= 0 and cell[x] == cell[y] and counts[int(cell[x])] > 0
+                and len(own_patterns(box_arcs(k, lo[[x]], hi[[x]]), counts[int(cell[x])])[0]) == 1)
+    x, y = pair
+    count = counts[int(cell[x])]
+    start = (x, next(iter(own_patterns(box_arcs(k, lo[[x]], hi[[x]]), count)[0])))
+    monkeypatch.setattr(pb, "RIVAL_BOXES", 0)
+    bar, why, _ = pb.flood(paper_geometry, lo, hi, a, b, count, start, {}, np.array([y]), budget=1000)
+    assert bar is None and "another cell of its signature in [" in why
+    assert f"[{lo[y][0]:.3f}, {lo[y][1]:.3f}, {lo[y][2]:.3f}] x [{hi[y][0]:.3f}" in why, why

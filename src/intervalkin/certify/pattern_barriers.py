@@ -165,9 +165,13 @@ def flood(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: 
             got = prune_relations(k, f_lo, f_hi, [rel[t] for t in f.tolist()], count, np.arange(f.size))
             rel.update(zip(f.tolist(), got))
             untested[f] = False
-        if rivals.size and sum(1 for x in rivals.tolist() if found.get(x)) > RIVAL_BOXES:
-            return None, ("its patterns reach boxes of another cell of its signature (the face relations there do "
-                          "not tell the two apart)"), ranged
+        reached = [x for x in rivals.tolist() if found.get(x)] if rivals.size else []
+        if len(reached) > RIVAL_BOXES:
+            # where: the place a finer paving (or a model of the wall between the cells) would be needed
+            at_lo, at_hi = lo[reached].min(axis=0), hi[reached].max(axis=0)
+            return None, ("its patterns reach boxes of another cell of its signature in "
+                          f"[{', '.join(f'{v:.3f}' for v in at_lo)}] x [{', '.join(f'{v:.3f}' for v in at_hi)}] "
+                          "(the face relations there do not tell the two apart)"), ranged
         for leaf, pats in forbidden.items():
             if found.get(leaf, set()) & pats:
                 return None, "its patterns reach another cell's witness (a finer paving would be needed)", ranged
