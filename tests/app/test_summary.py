@@ -83,8 +83,13 @@ def test_count_barriers_are_reported_beside_the_separations():
     summary = {"joint_cells": {"separations": {"by_signature": [
         {"signature": [0, 0, 0]}, {"signature": [2, 1, 1]}, {"signature": [4, 2, 2]}]}}}
     summary["basic_regions"] = {"lower_bound": 6, "why": "Theorem 1"}
-    claims = [{"cell": 7, "signature": [0, 0, 0]}, {"cell": 6, "signature": [0, 0, 0]},
-              {"cell": 3, "signature": [4, 2, 2], "kind": "pattern"}]
+    def at(*q):
+        return {"witness": [str(v) for v in q]}
+
+    claims = [{"cell": 7, "signature": [0, 0, 0], "witness": at(11, 11, 11), "others": [at(12, 12, 12)]},
+              {"cell": 6, "signature": [0, 0, 0], "witness": at(12, 12, 12), "others": [at(11, 11, 11)]},
+              {"cell": 3, "signature": [4, 2, 2], "kind": "pattern", "witness": at(14, 15, 16),
+               "others": [at(17, 18, 19)]}]
     add_barrier_certificates(summary, claims)
     got = summary["joint_cells"]["separations"]["count_barriers"]
     assert [r["components_at_least"] for r in got["by_signature"]] == [3, 2]

@@ -249,10 +249,28 @@ def test_the_summary_bound_of_the_barriers_is_checked(built, paper_geometry, tmp
     per separated cell of n solutions, over the claims it verified; a higher stated number fails."""
     from intervalkin.recheck.separation_file import barrier_bound
 
-    claims = [{"signature": [2, 1, 1], "cell": 9}, {"signature": [4, 2, 2], "cell": 3},
-              {"signature": [4, 2, 2], "cell": 3}, {"signature": [0, 0, 0], "cell": 7}]
-    assert barrier_bound(12, claims, [True, True, True, True]) == 12 + 2 + 4  # cell 3 counted once
+    def at(*q):
+        return {"witness": [str(v) for v in q]}
+
+    a, b, c, d = at(11, 12, 13), at(14, 15, 16), at("17.5", 18, 19), at(20, 21, 22)
+    claims = [{"signature": [2, 1, 1], "cell": 9, "witness": a, "others": [b]},
+              {"signature": [4, 2, 2], "cell": 3, "witness": c, "others": [a, d]},
+              {"signature": [4, 2, 2], "cell": 3, "witness": c, "others": [a, d]},
+              {"signature": [0, 0, 0], "cell": 7, "witness": d, "others": [a]}]
+    assert barrier_bound(12, claims, [True, True, True, True]) == 12 + 2 + 4  # the repeated claim counted once
     assert barrier_bound(12, claims, [False, True, True, True]) == 16
+    # one claim per cell of a signature proves its cells apart, no more: 2 cells of 2 solutions, not 3
+    both = [{"signature": [2, 1, 1], "cell": 0, "witness": a, "others": [b]},
+            {"signature": [2, 1, 1], "cell": 9, "witness": b, "others": [a]}]
+    assert barrier_bound(12, both, [True, True]) == 14
+    # a witness renamed as another cell is still one point
+    renamed = [{"signature": [2, 1, 1], "cell": 0, "witness": a, "others": [b]},
+               {"signature": [2, 1, 1], "cell": 5, "witness": a, "others": [b]}]
+    assert barrier_bound(12, renamed, [True, True]) == 14
+    # three cells, each told from the two others by one claim each: a triangle, 3 components
+    tri = [{"signature": [4, 2, 2], "cell": i, "witness": w, "others": o}
+           for i, (w, o) in enumerate(((a, [b, c]), (b, [c])))]
+    assert barrier_bound(12, tri, [True, True]) == 12 + 4 * 2
     c, arrays, _ = built
     write_json(tmp_path / "certificates" / "index.json", {"geometry_toml": paper_geometry.to_toml()})
     write_json(tmp_path / "certificates" / "counts.json", {"claims": [{"name": "basic_regions", "lower_bound": 12}]})

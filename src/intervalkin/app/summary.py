@@ -14,6 +14,7 @@ import numpy as np
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 from intervalkin.pipeline import Analysis
+from intervalkin.recheck.separation_file import barrier_bound
 from intervalkin.space.joint_closure import closed_cells
 from intervalkin.space.joint_separation import separated_cells
 from intervalkin.space.joint_space import JointPaving
@@ -256,9 +257,9 @@ def add_barrier_certificates(summary: dict, claims: list[dict]) -> None:
     }
     block = summary.get("basic_regions")
     lower = None if block is None else block.get("lower_bound", block.get("lower"))
-    # what verify re-proves (recheck.separation_file.barrier_bound): the counts claim's bound, plus n for each cell
-    # of n solutions told apart from the others of its signature
-    proved = None if lower is None else lower + sum(sig[0] * len(set(cells)) for sig, cells in by_sig.items())
+    # what verify re-proves: the counts claim's bound, plus n for each witness of n solutions in a largest set that
+    # the claims prove pairwise apart, beyond the first (one cell of each signature is in the bound already)
+    proved = None if lower is None else barrier_bound(lower, claims, [True] * len(claims))
     if proved is not None and proved > lower:
         # the certified lower bound is the larger one: verify re-proves both halves (the counts claim in the arb
         # checker, the barriers and this sum in the recheck's barrier_bound verdict), and the checker accepts a

@@ -288,16 +288,51 @@ def recheck_separations(folder: str | Path) -> list[CheckResult]:
 
 
 def barrier_bound(counts_lower: int, claims: list, verified: list[bool]) -> int:
-    """The basic regions the verified barriers prove beside the counts claim's lower bound L (Theorem 1 over the
-    distinct aspect splits of the verified solves): L plus, for each signature, count times the number of its
-    distinct cells with a verified claim.  Each such cell is apart from every other cell of its signature, so k of
-    them make k + 1 components, and L holds one of each signature it counts at most (one more component of n
-    solutions is n more basic regions; a signature L misses only makes the sum smaller than the truth)."""
-    cells: dict[tuple, set] = {}
+    """The basic regions the verified barriers prove beside the counts claim's lower bound L
+    (proofs/lemma-count-barrier.md, last section): L plus, for each signature with n solutions, n times (k - 1),
+    where k is the size of the largest set of its witness points proved pairwise apart by the verified claims
+    (a claim proves its witness apart from each of its others).  L counts one component of each signature at
+    most, and a signature L misses only makes the sum smaller than the truth.  Witnesses are compared as the
+    exact points they are, not by the cell numbers the file gives them, so a claim written twice, or one per
+    cell of a signature, proves no more than its points do."""
+    apart: dict[tuple, dict[tuple, set[tuple]]] = {}
     for claim, ok in zip(claims, verified):
-        if ok:
-            cells.setdefault(tuple(claim["signature"]), set()).add(claim.get("cell"))
-    return counts_lower + sum(sig[0] * len(c) for sig, c in cells.items())
+        if not ok:
+            continue
+        graph = apart.setdefault(tuple(claim["signature"]), {})
+        x = _point(claim["witness"])
+        for other in claim["others"]:
+            y = _point(other)
+            if y != x:
+                graph.setdefault(x, set()).add(y)
+                graph.setdefault(y, set()).add(x)
+    return counts_lower + sum(sig[0] * (_largest_clique(g) - 1) for sig, g in apart.items() if g)
+
+
+def _point(witness: dict) -> tuple[Fraction, ...]:
+    return tuple(Fraction(str(v)) for v in witness["witness"])
+
+
+def _largest_clique(graph: dict[tuple, set[tuple]]) -> int:
+    """The size of a largest set of pairwise adjacent vertices (Bron-Kerbosch with pivots: a signature has a few
+    dozen witnesses at most)."""
+    best = 0
+
+    def grow(size: int, cand: set, done: set) -> None:
+        nonlocal best
+        if not cand and not done:
+            best = max(best, size)
+            return
+        if size + len(cand) <= best:
+            return
+        pivot = max(cand | done, key=lambda v: len(graph[v] & cand))
+        for v in list(cand - graph[pivot]):
+            grow(size + 1, cand & graph[v], done & graph[v])
+            cand = cand - {v}
+            done = done | {v}
+
+    grow(0, set(graph), set())
+    return best
 
 
 def _summary_bound(root: Path, claims: list, results: list[CheckResult]) -> CheckResult | None:

@@ -109,7 +109,8 @@ class Separation:
                              "modelled leaves) that may hold that signature joins them (proofs/lemma-separation.md, "
                              "lemma-window-patterns.md, lemma-refuted-contact.md); proved by the library; the ones "
                              "a count barrier also proves are in certificates/joint_separation.json, re-proved by "
-                             "intervalkin verify (count_barriers); the certified count bounds do not use them yet"}
+                             "intervalkin verify (count_barriers), and only those raise the certified lower bound "
+                             "of the basic regions"}
 
 
 def leaf_signatures(jp) -> np.ndarray:
