@@ -19,8 +19,10 @@ from intervalkin.core.geometry import Geometry
 
 __all__ = ["uncovered_boundary", "require_covered", "face_pairs"]
 
-#: Region boxes compared at once when looking for the pairs that share a face.
-_CHUNK = 2048
+#: Region boxes taken as one run when looking for the pairs that share a face, and (run box, candidate) pairs
+#: compared at once (about 100 MB of temporaries).
+_CHUNK = 512
+_CELLS = 1 << 22
 
 
 def _cover(u: np.ndarray, w: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -80,16 +82,30 @@ def require_covered(r_lo: np.ndarray, r_hi: np.ndarray, b_lo: np.ndarray, b_hi: 
 
 def face_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Every pair i < j of closed boxes whose intersection has dimension 2 or 3 (a shared piece of face, or an
-    overlap): exact float comparisons, in chunks of rows."""
+    overlap): exact float comparisons, sorted by i then j.
+
+    The boxes are taken in runs of :data:`_CHUNK` consecutive ones in the order of their lower x end; a box
+    meeting one of a run has lo_x <= the run's largest hi_x and hi_x >= its smallest lo_x, a necessary condition
+    tested first in one dimension, so the full test compares each run with a slab of the boxes, not all of
+    them (a region of 67 000 boxes: seconds and megabytes instead of minutes and 13 GB)."""
     n = lo.shape[0]
+    order = np.argsort(lo[:, 0], kind="stable")
     out_i, out_j = [], []
     for s in range(0, n, _CHUNK):
-        blo, bhi = lo[s:s + _CHUNK, None, :], hi[s:s + _CHUNK, None, :]
-        ext_lo, ext_hi = np.maximum(blo, lo[None]), np.minimum(bhi, hi[None])
-        meet = np.all(ext_lo <= ext_hi, axis=2) & ((ext_lo < ext_hi).sum(axis=2) >= 2)
-        i, j = np.nonzero(meet)
-        i = i + s
-        keep = i < j
-        out_i.append(i[keep])
-        out_j.append(j[keep])
-    return np.concatenate(out_i), np.concatenate(out_j)
+        rows = order[s:s + _CHUNK]
+        cand = np.flatnonzero((lo[:, 0] <= hi[rows, 0].max()) & (hi[:, 0] >= lo[rows, 0].min()))
+        step = max(1, _CELLS // rows.size)
+        for t in range(0, cand.size, step):
+            c = cand[t:t + step]
+            ext_lo = np.maximum(lo[rows, None, :], lo[None, c, :])
+            ext_hi = np.minimum(hi[rows, None, :], hi[None, c, :])
+            meet = np.all(ext_lo <= ext_hi, axis=2) & ((ext_lo < ext_hi).sum(axis=2) >= 2)
+            a, b = np.nonzero(meet)
+            i, j = rows[a], c[b]
+            keep = i < j
+            out_i.append(i[keep])
+            out_j.append(j[keep])
+    i = np.concatenate(out_i) if out_i else np.zeros(0, dtype=np.int64)
+    j = np.concatenate(out_j) if out_j else np.zeros(0, dtype=np.int64)
+    at = np.lexsort((j, i))
+    return i[at], j[at]
