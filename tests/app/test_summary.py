@@ -83,11 +83,13 @@ def test_count_barriers_are_reported_beside_the_separations():
     summary = {"joint_cells": {"separations": {"by_signature": [
         {"signature": [0, 0, 0]}, {"signature": [2, 1, 1]}, {"signature": [4, 2, 2]}]}}}
     summary["basic_regions"] = {"lower_bound": 6, "why": "Theorem 1"}
+
     def at(*q):
         return {"witness": [str(v) for v in q]}
 
-    claims = [{"cell": 7, "signature": [0, 0, 0], "witness": at(11, 11, 11), "others": [at(12, 12, 12)]},
-              {"cell": 6, "signature": [0, 0, 0], "witness": at(12, 12, 12), "others": [at(11, 11, 11)]},
+    w7, w6, w5 = at(11, 11, 11), at(12, 12, 12), at(13, 13, 13)
+    claims = [{"cell": 7, "signature": [0, 0, 0], "witness": w7, "others": [w6, w5]},
+              {"cell": 6, "signature": [0, 0, 0], "witness": w6, "others": [w7, w5]},
               {"cell": 3, "signature": [4, 2, 2], "kind": "pattern", "witness": at(14, 15, 16),
                "others": [at(17, 18, 19)]}]
     add_barrier_certificates(summary, claims)
@@ -113,6 +115,7 @@ def test_the_report_says_which_separations_the_certificates_hold():
     summary = {"joint_cells": {"separations": {"by_signature": [{"signature": [0, 0, 0]}, {"signature": [2, 1, 1]}]}}}
     sep = summary["joint_cells"]["separations"]
     assert "not yet in the certificates" in _barrier_text(sep)
-    add_barrier_certificates(summary, [{"cell": 7, "signature": [0, 0, 0]}])
+    add_barrier_certificates(summary, [{"cell": 7, "signature": [0, 0, 0], "witness": {"witness": ["11", "11", "11"]},
+                                        "others": [{"witness": ["12", "12", "12"]}, {"witness": ["13", "13", "13"]}]}])
     text = _barrier_text(sep)
     assert "cell 7 from" in text and "at least 3 components" in text and "joint_separation.json" in text

@@ -14,7 +14,7 @@ import numpy as np
 from intervalkin.paving.labels import Label
 from intervalkin.paving.tree import Paving
 from intervalkin.pipeline import Analysis
-from intervalkin.recheck.separation_file import barrier_bound
+from intervalkin.recheck.separation_file import barrier_bound, components_apart
 from intervalkin.space.joint_closure import closed_cells
 from intervalkin.space.joint_separation import separated_cells
 from intervalkin.space.joint_space import JointPaving
@@ -236,7 +236,9 @@ def add_barrier_certificates(summary: dict, claims: list[dict]) -> None:
     for c in claims:
         by_sig.setdefault(tuple(c["signature"]), []).append(int(c["cell"]))
         kinds.setdefault(c.get("kind", "count"), []).append(int(c["cell"]))
-    rows = [{"signature": list(sig), "cells": sorted(cells), "components_at_least": len(cells) + 1}
+    # counted as verify counts them: witness points proved pairwise apart (k claims against all others: k + 1)
+    apart = components_apart(claims, [True] * len(claims))
+    rows = [{"signature": list(sig), "cells": sorted(set(cells)), "components_at_least": apart[sig]}
             for sig, cells in sorted(by_sig.items())]
     barred = {tuple(r["signature"]): r["components_at_least"] for r in rows}
     signatures = {tuple(b["signature"]) for b in sep.get("by_signature", [])} | set(barred)

@@ -49,7 +49,8 @@ from intervalkin.recheck.paving_file import folder_geometry
 from intervalkin.recheck.region_boundary import face_pairs, require_covered, uncovered_boundary
 
 __all__ = ["CLAIMS", "ARRAYS", "KIND", "uncovered_boundary", "face_pairs", "check_separation",
-           "check_pattern_separation", "recheck_separations", "barrier_bound"]
+           "check_pattern_separation", "recheck_separations", "barrier_bound",
+           "components_apart"]
 
 #: Where an output folder keeps the separation claims and their boxes.
 CLAIMS = Path("certificates") / "joint_separation.json"
@@ -290,11 +291,16 @@ def recheck_separations(folder: str | Path) -> list[CheckResult]:
 def barrier_bound(counts_lower: int, claims: list, verified: list[bool]) -> int:
     """The basic regions the verified barriers prove beside the counts claim's lower bound L
     (proofs/lemma-count-barrier.md, last section): L plus, for each signature with n solutions, n times (k - 1),
-    where k is the size of the largest set of its witness points proved pairwise apart by the verified claims
-    (a claim proves its witness apart from each of its others).  L counts one component of each signature at
-    most, and a signature L misses only makes the sum smaller than the truth.  Witnesses are compared as the
-    exact points they are, not by the cell numbers the file gives them, so a claim written twice, or one per
-    cell of a signature, proves no more than its points do."""
+    where k is :func:`components_apart` of the signature.  L counts one component of each signature at most, and
+    a signature L misses only makes the sum smaller than the truth."""
+    return counts_lower + sum(sig[0] * (k - 1) for sig, k in components_apart(claims, verified).items())
+
+
+def components_apart(claims: list, verified: list[bool]) -> dict[tuple, int]:
+    """Per signature of the verified claims: the size of a largest set of its witness points proved pairwise
+    apart (a claim proves its witness apart from each of its others), a lower bound of its components.
+    Witnesses are compared as the exact points they are, not by the cell numbers the file gives them, so a
+    claim written twice, or one per cell of a signature, proves no more than its points do."""
     apart: dict[tuple, dict[tuple, set[tuple]]] = {}
     for claim, ok in zip(claims, verified):
         if not ok:
@@ -306,7 +312,7 @@ def barrier_bound(counts_lower: int, claims: list, verified: list[bool]) -> int:
             if y != x:
                 graph.setdefault(x, set()).add(y)
                 graph.setdefault(y, set()).add(x)
-    return counts_lower + sum(sig[0] * (_largest_clique(g) - 1) for sig, g in apart.items() if g)
+    return {sig: max(1, _largest_clique(g)) for sig, g in apart.items()}
 
 
 def _point(witness: dict) -> tuple[Fraction, ...]:
