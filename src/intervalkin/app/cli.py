@@ -212,7 +212,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "every counted cell holds certified boxes (Proposition 1 seen in full)")
         p.add_argument("--barrier-faces", type=int, metavar="F", default=None,
                        help=f"faces the pattern barriers may relate in all, {BARRIER_FACES[0]}..{BARRIER_FACES[1]} "
-                            f"(default {PATTERN_BUDGET}); about 5 ms a face: 400000 (about 10 minutes more) also "
+                            f"(default {PATTERN_BUDGET}); about 5 ms a face: 400000 (about 12 minutes more) also "
                             "certifies a 4-solution cell on limits [10.5, 32]")
 
     p = sub.add_parser("label", help="certified aspect, basic region and uniqueness domain of a pose")
