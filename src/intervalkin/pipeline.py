@@ -234,10 +234,10 @@ class Analysis:
         ``barrier_faces``: faces the pattern barriers may range (None: the default budget).
         :func:`verify` re-proves every claim from the files alone.
         """
-        extra = {} if barrier_faces is None else {"barrier_faces": barrier_faces}
         return write_certificates(folder, self.geometry, dkp_results=dkp_results, joint=self.joint,
                                   regions=self.regions, trajectories=trajectories, counts=self.counts(),
-                                  aspect_topology=self.aspect_topology, joint_cells=self.cells, **extra)
+                                  aspect_topology=self.aspect_topology, joint_cells=self.cells,
+                                  barrier_faces=barrier_faces)
 
 
 @dataclass(frozen=True)

@@ -186,8 +186,8 @@ def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
                      budget: int = PATTERN_BUDGET) -> tuple[list[tuple[dict, list[dict], PatternBarrier]], list[dict]]:
     """Pattern barriers (:mod:`intervalkin.certify.pattern_barriers`) for the cells with solutions whose signature
     two cells or more share: for a signature with k cells, barriers are tried cell by cell, smallest first, until
-    k - 1 are found (enough to tell every pair apart) or ``budget`` faces are ranged in all.  Returns (witness, other witnesses (with ``cell``),
-    barrier, cell, signature) per barrier and what was left out."""
+    k - 1 are found (enough to tell every pair apart) or ``budget`` faces are ranged in all.  Returns (witness,
+    other witnesses (with ``cell``), barrier, cell, signature) per barrier and what was left out."""
     p = jp.paving
     out, omitted = [], []
     if not supported(geometry):

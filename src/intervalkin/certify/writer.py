@@ -175,7 +175,7 @@ def write_certificates(
     aspect_topology=None,
     joint_cells=None,
     separations: bool = True,
-    barrier_faces: int = PATTERN_BUDGET,
+    barrier_faces: int | None = None,
 ) -> list[Path]:
     """Write the certificate folder of the given results; return the paths written (index last).
 
@@ -207,8 +207,8 @@ def write_certificates(
         first: :mod:`~intervalkin.certify.joint_claims`); with ``separations`` also the count barriers
         ``joint_separation.json`` and ``.npz`` beside the claim files (:mod:`~intervalkin.certify.separation_claims`:
         tens of seconds on the default paving; ``intervalkin verify`` re-proves them).
-    barrier_faces : faces the pattern barriers may range in all (``--barrier-faces``): more certifies more
-        separations, at about 5 ms a face.
+    barrier_faces : faces the pattern barriers may range in all (``--barrier-faces``; None: PATTERN_BUDGET):
+        more certifies more separations, at about 5 ms a face.
 
     Every solve claim is re-checked with :mod:`intervalkin.checker` before it
     is written; refused ones are listed under ``omitted`` in ``index.json``.
@@ -224,7 +224,9 @@ def write_certificates(
 
     wanted = joint_cells is not None and separations
     # the pattern floods are serial: a second process runs them while this one proves the other claims
-    with Beside(pattern_barriers, joint_cells, geometry, precision, barrier_faces) if wanted else contextlib.nullcontext() as side:
+    budget = PATTERN_BUDGET if barrier_faces is None else barrier_faces
+    floods = Beside(pattern_barriers, joint_cells, geometry, precision, budget) if wanted else contextlib.nullcontext()
+    with floods as side:
         dkp_list = []
         for k, res in enumerate(dkp_results):
             got, why = dkp_claim(geometry, res, f"q-{k}", precision)

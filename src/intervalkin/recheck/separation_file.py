@@ -32,6 +32,7 @@ import zipfile
 from fractions import Fraction
 from pathlib import Path
 
+import networkx as nx
 import numpy as np
 
 from intervalkin.checker.claims import MALFORMED, run_check
@@ -301,44 +302,20 @@ def components_apart(claims: list, verified: list[bool]) -> dict[tuple, int]:
     apart (a claim proves its witness apart from each of its others), a lower bound of its components.
     Witnesses are compared as the exact points they are, not by the cell numbers the file gives them, so a
     claim written twice, or one per cell of a signature, proves no more than its points do."""
-    apart: dict[tuple, dict[tuple, set[tuple]]] = {}
+    apart: dict[tuple, nx.Graph] = {}
     for claim, ok in zip(claims, verified):
         if not ok:
             continue
-        graph = apart.setdefault(tuple(claim["signature"]), {})
+        graph = apart.setdefault(tuple(claim["signature"]), nx.Graph())
         x = _point(claim["witness"])
-        for other in claim["others"]:
-            y = _point(other)
-            if y != x:
-                graph.setdefault(x, set()).add(y)
-                graph.setdefault(y, set()).add(x)
-    return {sig: max(1, _largest_clique(g)) for sig, g in apart.items()}
+        graph.add_node(x)
+        graph.add_edges_from((x, y) for y in map(_point, claim["others"]) if y != x)
+    # a signature has a few dozen witnesses at most: an exact largest clique is cheap
+    return {sig: max(1, len(nx.max_weight_clique(g, weight=None)[0])) for sig, g in apart.items()}
 
 
 def _point(witness: dict) -> tuple[Fraction, ...]:
     return tuple(Fraction(str(v)) for v in witness["witness"])
-
-
-def _largest_clique(graph: dict[tuple, set[tuple]]) -> int:
-    """The size of a largest set of pairwise adjacent vertices (Bron-Kerbosch with pivots: a signature has a few
-    dozen witnesses at most)."""
-    best = 0
-
-    def grow(size: int, cand: set, done: set) -> None:
-        nonlocal best
-        if not cand and not done:
-            best = max(best, size)
-            return
-        if size + len(cand) <= best:
-            return
-        pivot = max(cand | done, key=lambda v: len(graph[v] & cand))
-        for v in list(cand - graph[pivot]):
-            grow(size + 1, cand & graph[v], done & graph[v])
-            cand = cand - {v}
-            done = done | {v}
-
-    grow(0, set(graph), set())
-    return best
 
 
 def _summary_bound(root: Path, claims: list, results: list[CheckResult]) -> CheckResult | None:
