@@ -111,6 +111,44 @@ def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retract
     assert checked["fold_piece"] >= 10 and checked["window_piece"] >= 2 and checked["pair_pattern"] >= 20, checked
 
 
+def test_fold_pieces_leave_sideways_where_the_sheet_keeps_them(fold_paving, retraction, paper_geometry):
+    """Property test against independent certified solves: from a point of a fold piece (its signature, which
+    the other piece of the box does not have), the segment along each sideways way (the sheet's slope proved)
+    keeps the piece's signature up to the face.  Reversing the slope signs makes it fail."""
+    r, p = retraction, fold_paving.paving
+    k = fold_paving.pieces.models.axis
+    axis_of = np.full(len(p.level), -1)
+    axis_of[fold_paving.pieces.box] = k
+    opt = np.flatnonzero(r.source[r.option_node] == SOURCES.index("fold_piece"))
+    face = np.argmax(r.option_faces[opt], axis=1)
+    sideways = opt[face // 2 != axis_of[r.leaf[r.option_node[opt]]]]
+    assert sideways.size > 50
+    rng = np.random.default_rng(23)
+    rng.shuffle(sideways)
+    checked = 0
+    for o in sideways[:320]:
+        node = r.option_node[o]
+        a = r.leaf[node]
+        for _ in range(8):
+            x = p.lo[a] + rng.random(3) * (p.hi[a] - p.lo[a])
+            if _signature(paper_geometry, x) == tuple(r.signature[node]):
+                break
+        else:
+            continue
+        e = r.option_direction[o]
+        ax = int(np.flatnonzero(e)[0])
+        end = p.hi[a, ax] if e[ax] > 0 else p.lo[a, ax]
+        for t in (0.2, 0.4, 0.6, 0.8, 1.0):
+            y = x.copy()
+            y[ax] = x[ax] + t * (end - x[ax])
+            got = _signature(paper_geometry, y)
+            assert got is None or got == tuple(r.signature[node]), (node, x, y)
+        checked += 1
+        if checked == 30:
+            break
+    assert checked >= 20, checked
+
+
 def test_plane_side_nodes_keep_their_side_and_signature_along_the_exit(fold_paving, retraction, paper_geometry):
     """Property test: a point of a resolved node on one side of a plane of double roots (the 50-digit sign of
     s(phi_D; rho^2) at the zero phi_D of D), of the node's signature (no other node of its leaf and side has

@@ -21,7 +21,8 @@ RETRACTS through face f of its leaf, of outward normal d e_l, when moving along 
 of the node in it up to the face:
 
 * a node of a clear leaf: through every face (the signature is the same on the whole box);
-* the fold piece below: through the -e_k face; the piece above: through the +e_k face;
+* the fold piece below: through the -e_k face; the piece above: through the +e_k face; and sideways through
+  the e_l face on the side where the sheet's height h rises (below) or falls (above), when dh/dr_l is proved;
 * a pattern node: along a direction e of :data:`DIRECTIONS`, through the faces on the sides of e's nonzero
   entries, when for each pair window i the sign of s D_e f at the roots of f on the window's critical pieces
   (:func:`~intervalkin.solve.window_fold.pair_direction_signs` with ``at_roots``) is +1 where the window is
@@ -144,7 +145,7 @@ def retract_joint_paving(jp, geometry: Geometry, workers: Workers | None = None)
     n = len(jp.cell)
     nodes = Nodes()
     clear_nodes(jp, nodes)
-    fold_nodes(jp, nodes)
+    fold_nodes(jp, geometry, nodes)
     left_rows = window_nodes(jp, geometry, nodes, workers)
     covered = np.zeros(n, dtype=bool)
     for part in nodes.parts:
