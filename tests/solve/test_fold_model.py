@@ -20,6 +20,7 @@ from intervalkin.core.interval import PI_LO
 from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.fold_model import side_of
+from intervalkin.solve.fold_side import placed_side
 from tests.solve.shared import split_of
 
 
@@ -93,6 +94,37 @@ def test_a_wrong_side_is_caught(folds, paper_geometry):
         if cid >= 0 and cells[cid].count >= 0:
             wrong += cells[cid].signature != split
     assert wrong >= 10
+
+
+def test_points_placed_by_the_tight_test_are_on_their_side(folds, paper_geometry):
+    """The tight side test (the preconditioner taken again over the shrunk pose box) places points the quick
+    one leaves undecided; checked against independent complete solves: in each box every point placed below
+    has one signature, every point placed above another, two solutions apart.  Swapping the sides the tight
+    test adds mixes them and fails."""
+    rng = np.random.default_rng(8)
+    rows = rng.choice(len(folds.pieces), size=min(120, len(folds.pieces)), replace=False)
+    t, q = _random_points(folds, rows, rng, 12)
+    quick = side_of(paper_geometry, folds.pieces.models, t, q)
+    side = placed_side(paper_geometry, folds.pieces.models, t, q)
+    assert np.all((quick == 0) | (quick == side))  # the tight test only adds placements
+    tight = (quick == 0) & (side != 0)
+    assert tight.sum() >= 30, int(tight.sum())
+    seen: dict[tuple[int, int], set] = {}
+    for row in np.unique(t[tight]):
+        at = np.flatnonzero(t == row)
+        at = at[side[at] != 0]
+        if not ((side[at] < 0).any() and (side[at] > 0).any()):
+            continue
+        for i in at[:6]:
+            split = split_of(solve(paper_geometry, [Fraction(float(v)) for v in q[i]]))
+            seen.setdefault((int(row), int(side[i])), set()).add(split)
+    boxes = {row for row, _ in seen if (row, -1) in seen and (row, 1) in seen}
+    assert len(boxes) >= 5, len(boxes)
+    for row in boxes:
+        below, above = seen[(row, -1)], seen[(row, 1)]
+        assert len(below) == 1 and len(above) == 1, (row, below, above)
+        (b,), (a,) = below, above
+        assert abs(a[0] - b[0]) == 2, (row, b, a)
 
 
 def _singular_poses(geometry, boxes, rng, per_box):

@@ -29,9 +29,9 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.enclosures import det_a_gradient_interval, jacobian_interval, rho_sq_leg_interval
 from intervalkin.kinematics.fold_side import pair_side
-from intervalkin.solve.fold_model import SIDE_STEPS, FoldModels, krawczyk_image, normal_signs, preconditioned
+from intervalkin.solve.fold_model import SIDE_STEPS, FoldModels, krawczyk_image, normal_signs, preconditioned, side_of
 
-__all__ = ["pair_sides", "side_of_tight", "FoldSides", "PAIR", "GRID", "BISECTIONS"]
+__all__ = ["pair_sides", "side_of_tight", "placed_side", "FoldSides", "PAIR", "GRID", "BISECTIONS"]
 
 #: The signature change (count, n_wa1, n_wa2) from the piece below to the piece above when s = +1.
 PAIR = np.array([2, 1, 1], dtype=np.int64)
@@ -221,3 +221,14 @@ def side_of_tight(geometry: Geometry, models: FoldModels, box: np.ndarray, point
         out[sel[fin & (qk2.hi < h2.lo)]] = -1
         out[sel[fin & (qk2.lo > h2.hi)]] = 1
     return out
+
+
+def placed_side(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(m,) int8: the quick side test (:func:`intervalkin.solve.fold_model.side_of`), and the tight one
+    (:func:`side_of_tight`) where it does not decide: a point close to the sheet, or in a box whose model's own
+    C contracts weakly (there the quick test stalls at every point of the box).  Certified."""
+    side = side_of(geometry, models, box, points)
+    near = np.flatnonzero(side == 0)
+    if near.size:
+        side[near] = side_of_tight(geometry, models, np.asarray(box)[near], np.asarray(points)[near])
+    return side

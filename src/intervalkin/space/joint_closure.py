@@ -36,8 +36,8 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.paving.adjacency import shares_face
-from intervalkin.solve.fold_model import normal_signs, side_of
-from intervalkin.solve.fold_side import side_of_tight
+from intervalkin.solve.fold_model import normal_signs
+from intervalkin.solve.fold_side import placed_side
 from intervalkin.solve.window_fold import CLEAR, FOLD, extreme_corners
 from intervalkin.space.joint_window_pieces import window_sides
 
@@ -274,22 +274,13 @@ def _trace_points(jp, geometry: Geometry, kind: np.ndarray, leaf: np.ndarray, fl
             d = fold_dir[t[mono]]
             f_lo, f_hi = flo[fd[mono]], fhi[fd[mono]]
             low_corner, high_corner = np.where(d > 0, f_hi, f_lo), np.where(d > 0, f_lo, f_hi)
-            side = _fold_side(geometry, jp.pieces.models, np.r_[t[mono], t[mono]],
+            side = placed_side(geometry, jp.pieces.models, np.r_[t[mono], t[mono]],
                               np.concatenate([low_corner, high_corner]))
             s_below, s_above = side[:mono.size], side[mono.size:]
             pts[fd[mono], 0], pts[fd[mono], 1] = low_corner, high_corner
             present[fd[mono], 0] = np.where(s_below < 0, 1, np.where(s_below > 0, 0, -1))
             present[fd[mono], 1] = np.where(s_above > 0, 1, np.where(s_above < 0, 0, -1))
     return pts, piece, present
-
-
-def _fold_side(geometry: Geometry, models, rows: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """The quick side test, and the tight one where it does not decide (points close to the sheet)."""
-    side = side_of(geometry, models, rows, points)
-    near = np.flatnonzero(side == 0)
-    if near.size:
-        side[near] = side_of_tight(geometry, models, rows[near], points[near])
-    return side
 
 
 def _place(jp, geometry: Geometry, kind: np.ndarray, leaf: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -302,6 +293,6 @@ def _place(jp, geometry: Geometry, kind: np.ndarray, leaf: np.ndarray, points: n
         out[wf] = window_sides(geometry, w, np.searchsorted(w.leaf, leaf[wf]), points[wf])
     fd = np.flatnonzero(kind[leaf] == 3)
     if fd.size:
-        side = _fold_side(geometry, jp.pieces.models, _fold_row(jp, leaf[fd]), points[fd])
+        side = placed_side(geometry, jp.pieces.models, _fold_row(jp, leaf[fd]), points[fd])
         out[fd] = np.where(side > 0, 1, np.where(side < 0, 0, -1))
     return out

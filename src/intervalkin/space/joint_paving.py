@@ -57,8 +57,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers, default_workers, one_blas_thread
 from intervalkin.paving.budget import check_depth
 from intervalkin.paving.tree import Paving
-from intervalkin.solve.fold_model import side_of
-from intervalkin.solve.fold_side import side_of_tight
+from intervalkin.solve.fold_side import placed_side
 from intervalkin.space.joint_leaves import adaptive_leaves, leaves_to_paving, refine_leaves, timed_step
 from intervalkin.space.joint_cells import CellSolver, JointSpaceCell, joining_paths
 from intervalkin.space.joint_models import ModelStore
@@ -174,7 +173,7 @@ class JointSpacePaving:
         contains it entirely, -1 when that leaf is undecided or no single leaf contains it.
 
         With ``geometry``, a point in a fold box is placed in one of its two pieces by the
-        side test (:func:`intervalkin.solve.fold_model.side_of`) and gets that piece's cell.
+        side test (:func:`intervalkin.solve.fold_side.placed_side`) and gets that piece's cell.
         """
         q = np.asarray(rho, dtype=np.float64)
         boxes = np.stack([q, q], axis=-1) if q.ndim == 2 else q
@@ -189,7 +188,7 @@ class JointSpacePaving:
         t = np.where(leaf >= 0, row[np.maximum(leaf, 0)], -1)
         at = np.flatnonzero((out < 0) & (t >= 0))
         if at.size:
-            side = side_of(geometry, self.pieces.models, t[at], q[at])
+            side = placed_side(geometry, self.pieces.models, t[at], q[at])
             pc = self.piece_cell.reshape(-1, 2)[t[at], (side > 0).astype(np.int64)]
             out[at] = np.where(side != 0, pc, -1)
         return self._window_cells(out, leaf, q, geometry)
@@ -224,10 +223,7 @@ class JointSpacePaving:
         t = np.where(leaf >= 0, row[np.maximum(leaf, 0)], -1)
         at = np.flatnonzero((out[:, 0] < 0) & (t >= 0))
         if at.size:
-            side = side_of(geometry, self.pieces.models, t[at], q[at])
-            near = np.flatnonzero(side == 0)  # close to the sheet: the tight enclosure of its pose decides
-            if near.size:
-                side[near] = side_of_tight(geometry, self.pieces.models, t[at][near], q[at][near])
+            side = placed_side(geometry, self.pieces.models, t[at], q[at])
             sig = self.piece_signatures.signature[t[at], (side > 0).astype(np.int64)]
             out[at] = np.where((side != 0)[:, None], sig, -1)
         return out

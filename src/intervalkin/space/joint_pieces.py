@@ -7,8 +7,9 @@ function along one axis k, and the box minus g(S) is two connected pieces, *belo
 
 Pieces join the cells of the paving through shared faces.  For two face-adjacent
 boxes, a few points of the shared face are placed: in a clear box a point is always
-placed (the box is off g(S)); in a fold box by the side test (a Krawczyk step at the
-point parameter).  A point placed at both ends lies in both pieces (or in the piece
+placed (the box is off g(S)); in a fold box by the side test (Krawczyk steps at the
+point parameter, with the preconditioner taken again over the shrunk box where the
+model's does not decide).  A point placed at both ends lies in both pieces (or in the piece
 and the clear box), off g(S), so their union is connected: an edge of the piece
 graph.  A point that cannot be placed gives no edge (a join not made, never a false
 one).  Each piece also keeps a *witness*: a point proved to lie in it, where a
@@ -29,8 +30,8 @@ from intervalkin.core.workers import Workers
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
-from intervalkin.solve.fold_model import FoldModels, side_of
-from intervalkin.solve.fold_side import PAIR, pair_sides
+from intervalkin.solve.fold_model import FoldModels
+from intervalkin.solve.fold_side import PAIR, pair_sides, placed_side
 
 __all__ = ["FoldPieces", "fold_pieces", "fold_sides", "placed_edges", "FACE_FRACTIONS", "PieceSignatures", "piece_signatures"]
 
@@ -77,17 +78,18 @@ def _face_points(lo: np.ndarray, hi: np.ndarray, a: np.ndarray, b: np.ndarray) -
 
 def fold_sides(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray,
            workers: Workers) -> np.ndarray:
-    """:func:`side_of` in parts on the workers; each part ships only the models its points use."""
+    """:func:`~intervalkin.solve.fold_side.placed_side` (the quick side test, the tight one where it does not
+    decide) in parts on the workers; each part ships only the models its points use."""
     parts = workers.parts(len(box))
     if len(parts) == 1:
-        return side_of(geometry, models, box, points)
+        return placed_side(geometry, models, box, points)
     order = np.argsort(box, kind="stable")
     calls = []
     for a, b in parts:
         uniq, inv = np.unique(box[order[a:b]], return_inverse=True)
         calls.append((geometry, models.take(uniq), inv, points[order[a:b]]))
     out = np.empty(len(box), dtype=np.int8)
-    for (a, b), side in zip(parts, workers.run(side_of, calls)):
+    for (a, b), side in zip(parts, workers.run(placed_side, calls)):
         out[order[a:b]] = side
     return out
 
