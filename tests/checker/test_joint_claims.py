@@ -34,6 +34,7 @@ from intervalkin.kinematics.formulas import approx_inverse_kinematics
 from intervalkin.paving.labels import Label
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.fold_model import side_of
+from intervalkin.solve.fold_side import placed_side
 from tests.conftest import DATA
 from tests.solve.shared import box_across_singular_image, concurrent_legs_box, first_det_change
 
@@ -112,7 +113,41 @@ def test_models_are_the_library_models(paper_geometry, fold_paving, models):
         for name, want in (("below", -1), ("above", 1)):
             if name in c["witnesses"]:
                 q = np.array([[float(v) for v in read_joint_point(c["witnesses"][name], name)]])
-                assert side_of(paper_geometry, pc.models, np.array([t]), q)[0] == want
+                assert placed_side(paper_geometry, pc.models, np.array([t]), q)[0] == want
+
+
+def test_points_only_the_tight_side_test_places_are_re_proved(paper_geometry, fold_paving, monkeypatch):
+    """Points of fold boxes the library places only with its tight side test (the preconditioner taken again
+    over the shrunk pose box) are placed on the same side by the checker's side test (arb, its own Krawczyk
+    proof of the box); some need its fresh steps: without them it leaves them open, and a witness there would be
+    refused."""
+    import intervalkin.checker.joint_models as jm
+
+    pc, pav = fold_paving.pieces, fold_paving.paving
+    rng = np.random.default_rng(9)
+    t = np.repeat(np.arange(len(pc)), 4)
+    q = pav.lo[pc.box[t]] + rng.random((len(t), 3)) * (pav.hi[pc.box[t]] - pav.lo[pc.box[t]])
+    quick = side_of(paper_geometry, pc.models, t, q)
+    side = placed_side(paper_geometry, pc.models, t, q)
+    only = np.flatnonzero((quick == 0) & (side != 0))
+    model = ArbModel(paper_geometry)
+    placed = needed = 0
+    for row in rng.permutation(np.unique(t[only]))[:60]:
+        i = only[t[only] == row][0]
+        b = pc.box[row]
+        box = tuple((Fraction(float(pav.lo[b, a])), Fraction(float(pav.hi[b, a]))) for a in range(3))
+        pose = tuple((float(pc.models.pose[row, a, 0]), float(pc.models.pose[row, a, 1])) for a in range(3))
+        try:
+            proof = jm.FoldProof(model, box, int(pc.models.axis[row]), pose)
+        except jm.Refused:  # the checker's own Krawczyk proof of this box does not pass: no claim is written
+            continue
+        point = [Fraction(float(v)) for v in q[i]]
+        assert proof.side(point) == side[i], (row, point)
+        monkeypatch.setattr(jm, "FRESH_STEPS", 0)
+        needed += proof.side(point) == 0
+        monkeypatch.setattr(jm, "FRESH_STEPS", 3)
+        placed += 1
+    assert placed >= 30 and needed >= 3, (placed, needed)
 
 
 def test_edge_heights_criterion_verifies_where_it_holds(paper_geometry, models):
@@ -402,7 +437,7 @@ def test_side_test_agrees_with_the_library_and_with_solves(paper_geometry, fold_
             q = [lo + Fraction(int(rng.integers(1, 999)), 1000) * (hi - lo) for lo, hi in box]
             assert in_joint_box(q, box)
             mine = proof.side(q)
-            lib = side_of(paper_geometry, pc.models, np.array([t]), np.array([[float(v) for v in q]]))[0]
+            lib = placed_side(paper_geometry, pc.models, np.array([t]), np.array([[float(v) for v in q]]))[0]
             if mine and lib:
                 assert mine == lib
                 agreed += 1

@@ -43,6 +43,8 @@ __all__ = ["CRITERIA", "SIDE_STEPS", "FoldProof", "read_joint_box", "read_joint_
 CRITERIA = ("height_inside", "normal_signs", "edge_heights")
 #: Contraction steps of the side test and of the height enclosures.
 SIDE_STEPS = 6
+#: Steps of the side test with Y and C taken again over the shrunk balls, where the first ones leave it open.
+FRESH_STEPS = 3
 #: Sub-boxes per axis over which E'(X) is enclosed, tried in turn until the Krawczyk test passes.
 SPLITS = (1, 2, 4)
 _ZERO, _ONE = arb(0), arb(1)
@@ -133,20 +135,39 @@ class FoldProof:
         fs = (leg_sq(self.model, self.i), leg_sq(self.model, self.j), self.model.det)
         return [[slope_enclosure(f, X, e) for e in _UNIT] for f in fs]
 
-    def image(self, X: list, P: tuple) -> list:
-        """The Krawczyk image of the balls X (inside the pose box) for parameter balls P = (r_i, r_j)."""
+    def image(self, X: list, P: tuple, YC: tuple | None = None) -> list:
+        """The Krawczyk image of the balls X (inside the pose box) for parameter balls P = (r_i, r_j), with the
+        proof's Y and C, or with ``YC`` = (Y, C = I - Y E'(X')) for a box X' holding X."""
+        Y, C = (self.Y, self.C) if YC is None else YC
         M = [v.mid() for v in X]
         r = self.model.rho_sq(*M)
         E = [r[self.i] - P[0] * P[0], r[self.j] - P[1] * P[1], self.model.det(*M)]
         D = [x - m for x, m in zip(X, M)]
-        return [M[a] - sum(self.Y[a][b] * E[b] for b in range(3)) + sum(self.C[a][b] * D[b] for b in range(3))
+        return [M[a] - sum(Y[a][b] * E[b] for b in range(3)) + sum(C[a][b] * D[b] for b in range(3))
                 for a in range(3)]
 
-    def contract(self, P: tuple, steps: int = SIDE_STEPS) -> list:
-        """Balls holding X*(p) for every p in P: X intersected with successive images."""
-        X = list(self.X)
+    def _preconditioner(self, X: list) -> tuple | None:
+        """(Y, C) taken again over the balls X: Y the midpoint of the inverse of E' at X's midpoint (any Y will
+        do), C = I - Y E'(X); None where E' at the midpoint is not invertible."""
+        try:
+            inv = arb_mat(self._derivative([arb(v.mid()) for v in X])).inv()
+        except (ZeroDivisionError, ValueError):
+            return None
+        Y = [[inv[r, c].mid() for c in range(3)] for r in range(3)]
+        J = self._derivative(X)
+        C = [[(_ONE if r == c else _ZERO) - sum(Y[r][t] * J[t][c] for t in range(3)) for c in range(3)]
+             for r in range(3)]
+        return Y, C
+
+    def contract(self, P: tuple, steps: int = SIDE_STEPS, X: list | None = None, fresh: bool = False) -> list:
+        """Balls holding X*(p) for every p in P: X (the pose box) intersected with successive images, made
+        with the proof's Y and C, or (``fresh``) with Y and C taken again over the current balls."""
+        X = list(self.X) if X is None else X
         for _ in range(steps):
-            K = self.image(X, P)
+            YC = self._preconditioner(X) if fresh else None
+            if fresh and YC is None:
+                break
+            K = self.image(X, P, YC)
             if not all(x.overlaps(v) for x, v in zip(X, K)):
                 raise Refused("a contracted image is empty: the pose box holds no zero (contradicts the proof)")
             X = [x.intersection(v) for x, v in zip(X, K)]
@@ -157,10 +178,19 @@ class FoldProof:
         return value_enclosure(leg_sq(self.model, self.k), self.contract(P))
 
     def side(self, q) -> int:
-        """-1 when q_k < h(q_i, q_j) is PROVED, +1 when q_k > h is, 0 undecided (q: exact, inside R)."""
-        h2 = self.height_sq((exact_ball(q[self.i]), exact_ball(q[self.j])))
+        """-1 when q_k < h(q_i, q_j) is PROVED, +1 when q_k > h is, 0 undecided (q: exact, inside R).  Where the
+        proof's C leaves it open (its norm near 1 stalls the steps), FRESH_STEPS more with Y and C taken again
+        over the shrunk balls (proofs/lemma-fold-joint-box.md, point 5)."""
+        P = (exact_ball(q[self.i]), exact_ball(q[self.j]))
         qk2 = exact_ball(q[self.k] * q[self.k])
-        return -1 if qk2 < h2 else 1 if qk2 > h2 else 0
+        X = self.contract(P)
+        for fresh in (False, True):
+            if fresh:
+                X = self.contract(P, FRESH_STEPS, X, fresh=True)
+            h2 = value_enclosure(leg_sq(self.model, self.k), X)
+            if qk2 < h2 or qk2 > h2:
+                return -1 if qk2 < h2 else 1
+        return 0
 
     def normal_signs(self, X: list) -> list[int]:
         """Certified signs of w_l = u_m x u_n over the balls X (0: not proved); natural ∩ Taylor forms."""
