@@ -317,13 +317,16 @@ def _height(geometry: Geometry, X: np.ndarray, k: int, P: Interval, Y: np.ndarra
     return h
 
 
-def side_of(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray) -> np.ndarray:
+def side_of(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray,
+            poses: np.ndarray | None = None) -> np.ndarray:
     """(m,) int8: -1 where point q lies below the sheet of model ``box`` (q_k < h(q_i, q_j)), +1 above, 0 undecided.
 
     box : (m,) indices of boxes with a model; points : (m, 3) float joint vectors inside
     those boxes.  A few Krawczyk steps at the point parameter enclose X*(q_i, q_j) (the
     unique zero in the model's pose box); q is placed when q_k^2 is outside the
-    enclosure of rho_k^2 there.  Certified.
+    enclosure of rho_k^2 there.  Certified.  ``poses`` (m, 3, 2), when given, receives the
+    contracted pose box of each point (it holds X*(q_i, q_j); NaN where a step failed), from
+    which a tighter test may go on.
     """
     box = np.asarray(box, dtype=np.int64)
     q = np.asarray(points, dtype=np.float64)
@@ -334,12 +337,15 @@ def side_of(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.
         # each point's answer depends on it alone; in cache-sized pieces the interval kernels run far faster
         for s in range(0, sel.size, _SIDE_CHUNK):
             c = sel[s:s + _SIDE_CHUNK]
-            out[c] = _side(geometry, models, k, box[c], q[c])
+            out[c], X = _side(geometry, models, k, box[c], q[c])
+            if poses is not None:
+                poses[c] = X
     return out
 
 
-def _side(geometry: Geometry, models: FoldModels, k: int, rows: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """:func:`side_of` for points q (m, 3) in boxes ``rows`` whose models have axis k."""
+def _side(geometry: Geometry, models: FoldModels, k: int, rows: np.ndarray,
+          q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`side_of` for points q (m, 3) in boxes ``rows`` whose models have axis k: (sides, contracted poses)."""
     out = np.zeros(len(rows), dtype=np.int8)
     i, j = [a for a in range(3) if a != k]
     P = Interval.point(q[:, [i, j]])
@@ -359,7 +365,7 @@ def _side(geometry: Geometry, models: FoldModels, k: int, rows: np.ndarray, q: n
         Xt = np.stack([np.maximum(X[t, :, 0], K[:, :, 0]), np.minimum(X[t, :, 1], K[:, :, 1])], axis=-1)
         # an empty intersection cannot happen for a proved model; claim nothing then
         dead = ~fin | (Xt[:, :, 0] > Xt[:, :, 1]).any(axis=1)
-        X[t] = Xt
+        X[t] = np.where(dead[:, None, None], np.nan, Xt)
         h2 = rho_sq_leg_interval(geometry, np.where(dead[:, None, None], models.pose[rows[t]], Xt), k)
         below = ~dead & (qk2.hi[t] < h2.lo)
         above = ~dead & (qk2.lo[t] > h2.hi)
@@ -367,4 +373,4 @@ def _side(geometry: Geometry, models: FoldModels, k: int, rows: np.ndarray, q: n
         todo = t[~dead & ~below & ~above]
         if todo.size == 0:
             break
-    return out
+    return out, X

@@ -45,16 +45,18 @@ BISECTIONS = 12
 
 
 def _sheet_pose(geometry: Geometry, models: FoldModels, rows: np.ndarray, k: int, p: np.ndarray,
-                tight: bool = True) -> np.ndarray:
+                tight: bool = True, start: np.ndarray | None = None) -> np.ndarray:
     """Enclosures (m, 3, 2) of X*(p) for point parameters p (m, 2) of the models ``rows`` (axis k); NaN where lost.
 
     Krawczyk steps with the model's preconditioner first, then (``tight``) TIGHT_STEPS with one recomputed
     over the current, smaller box (any preconditioner keeps every zero of the box, so each
-    intersection still holds X*(p)).
+    intersection still holds X*(p)).  ``start``: boxes already contracted by the model's steps (each holding
+    X*(p), as :func:`~intervalkin.solve.fold_model.side_of` returns them): only the recomputed steps are taken.
     """
-    X = models.pose[rows].copy()
+    X = models.pose[rows].copy() if start is None else np.array(start, dtype=np.float64)
     P = Interval.point(p)
-    for step in range(SIDE_STEPS + (TIGHT_STEPS if tight else 0)):
+    first = 0 if start is None else SIDE_STEPS
+    for step in range(first, SIDE_STEPS + (TIGHT_STEPS if tight else 0)):
         if step < SIDE_STEPS:
             Y, C = models.inv[rows], models.contraction[rows]
         else:
@@ -201,7 +203,8 @@ def _empty_pieces(geometry: Geometry, search: _Search, rows: np.ndarray, corners
     empty[rows[at[above_empty & ~below_empty]]] = 1
 
 
-def side_of_tight(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray) -> np.ndarray:
+def side_of_tight(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray,
+                  start: np.ndarray | None = None) -> np.ndarray:
     """(m,) int8: like :func:`intervalkin.solve.fold_model.side_of` (-1 below the sheet, +1 above, 0 undecided),
     with the tight enclosure of X*(q_i, q_j) (recomputed preconditioner): for the few points the quick
     side test leaves undecided because they lie close to the sheet.  Certified.
@@ -214,7 +217,8 @@ def side_of_tight(geometry: Geometry, models: FoldModels, box: np.ndarray, point
         if sel.size == 0:
             continue
         i, j = [a for a in range(3) if a != k]
-        X = _sheet_pose(geometry, models, box[sel], k, q[sel][:, [i, j]])
+        X = _sheet_pose(geometry, models, box[sel], k, q[sel][:, [i, j]],
+                        start=None if start is None else np.asarray(start)[sel])
         fin = np.isfinite(X).all(axis=(1, 2))
         h2 = rho_sq_leg_interval(geometry, np.where(fin[:, None, None], X, 0.0), k)
         qk2 = Interval.point(q[sel, k]).sqr()
@@ -227,8 +231,9 @@ def placed_side(geometry: Geometry, models: FoldModels, box: np.ndarray, points:
     """(m,) int8: the quick side test (:func:`intervalkin.solve.fold_model.side_of`), and the tight one
     (:func:`side_of_tight`) where it does not decide: a point close to the sheet, or in a box whose model's own
     C contracts weakly (there the quick test stalls at every point of the box).  Certified."""
-    side = side_of(geometry, models, box, points)
+    poses = np.full((len(box), 3, 2), np.nan)
+    side = side_of(geometry, models, box, points, poses=poses)
     near = np.flatnonzero(side == 0)
-    if near.size:
-        side[near] = side_of_tight(geometry, models, np.asarray(box)[near], np.asarray(points)[near])
+    if near.size:  # the tight steps go on from the boxes the quick ones left
+        side[near] = side_of_tight(geometry, models, np.asarray(box)[near], np.asarray(points)[near], poses[near])
     return side
