@@ -206,8 +206,9 @@ def _empty_pieces(geometry: Geometry, search: _Search, rows: np.ndarray, corners
 def side_of_tight(geometry: Geometry, models: FoldModels, box: np.ndarray, points: np.ndarray,
                   start: np.ndarray | None = None) -> np.ndarray:
     """(m,) int8: like :func:`intervalkin.solve.fold_model.side_of` (-1 below the sheet, +1 above, 0 undecided),
-    with the tight enclosure of X*(q_i, q_j) (recomputed preconditioner): for the few points the quick
-    side test leaves undecided because they lie close to the sheet.  Certified.
+    with the tight enclosure of X*(q_i, q_j) (recomputed preconditioner): for the points the quick side test
+    leaves undecided, close to the sheet or in a box whose model's C contracts weakly.  ``start``: their pose
+    boxes as the quick test left them (the model's steps are not taken again).  Certified.
     """
     box = np.asarray(box, dtype=np.int64)
     q = np.asarray(points, dtype=np.float64)
