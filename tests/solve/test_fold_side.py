@@ -4,7 +4,9 @@ On the depth-5 fold paving of the paper's manipulator (``fold_paving``):
 - where a side s is proved, a point placed below the sheet and one placed above (side test)
   have certified signatures differing by exactly s (2, 1, 1);
 - where a piece is proved empty, no point of a grid over the box is placed in it;
-- mutation: with the sides negated, the same comparison fails.
+- mutation: with the sides negated, the same comparison fails;
+- where a piece is proved empty by parts, the sheet's height found by float Newton at a grid of the
+  parameter rectangle lies beyond the box's face on that side, and no grid point is placed in the piece.
 """
 
 from __future__ import annotations
@@ -16,7 +18,8 @@ import pytest
 
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.fold_model import side_of
-from intervalkin.solve.fold_side import PAIR, pair_sides
+from intervalkin.kinematics.formulas import approx_det_a, approx_inverse_kinematics
+from intervalkin.solve.fold_side import PAIR, empty_by_parts, pair_sides, placed_side
 from tests.solve.shared import split_of
 
 _GRID = np.array([(a, b, c) for a in (0.1, 0.5, 0.9) for b in (0.1, 0.5, 0.9) for c in (0.05, 0.3, 0.7, 0.95)])
@@ -75,3 +78,52 @@ def test_no_point_is_placed_in_an_empty_piece(paper_geometry, fold_paving, sides
         assert not np.any(s == fs.empty[t]), (t, R[t], fs.empty[t])
         placed += int(np.count_nonzero(s))
     assert placed >= 1000, "the grid points do get placed (in the other piece)"
+
+
+def _sheet_height(geometry, pose_box, k, p):
+    """h(p) = rho_k(X*(p)) by float Newton on (rho_i^2 - p_i^2, rho_j^2 - p_j^2, det A) from the pose box's
+    centre, with a finite-difference Jacobian (not certified: an independent check); None if it wanders off."""
+    i, j = [a for a in range(3) if a != k]
+    X = pose_box.mean(axis=1)
+
+    def E(X):
+        rho = approx_inverse_kinematics(geometry, X)
+        return np.array([rho[i] ** 2 - p[0] ** 2, rho[j] ** 2 - p[1] ** 2, approx_det_a(geometry, X)])
+    for _ in range(40):
+        J = np.stack([(E(X + h) - E(X - h)) / 2e-7 for h in np.eye(3) * 1e-7], axis=1)
+        X = X - np.linalg.solve(J, E(X))
+    if np.abs(E(X)).max() > 1e-8 or np.any(X < pose_box[:, 0] - 1e-9) or np.any(X > pose_box[:, 1] + 1e-9):
+        return None
+    return approx_inverse_kinematics(geometry, X)[k]
+
+
+def test_pieces_proved_empty_by_parts_hold_no_sheet_point(paper_geometry, fold_paving, sides):
+    """The parts' proof against float Newton: where the piece above is proved empty, h(p) >= hi_k at every point
+    of a 6 x 6 grid of the parameter rectangle (corners included), and h(p) <= lo_k where the piece below is; and
+    no grid point of the box is placed in it.  It proves pieces the monotone corner rule does not."""
+    R, fs = sides
+    pc = fold_paving.pieces
+    t = np.repeat(np.arange(len(R)), 2)
+    piece = np.tile([0, 1], len(R))
+    proved = empty_by_parts(paper_geometry, R[t], pc.models.take(t), piece)
+    assert proved.sum() >= 40, int(proved.sum())
+    new = proved & (fs.empty[t] != np.where(piece == 1, 1, -1))
+    assert new.sum() >= 5, int(new.sum())
+    rng = np.random.default_rng(12)
+    checked = 0
+    f = np.linspace(0.0, 1.0, 6)
+    for r in rng.permutation(np.flatnonzero(proved))[:40]:
+        box, k, side = t[r], int(pc.models.axis[t[r]]), int(piece[r])
+        i, j = [a for a in range(3) if a != k]
+        for a in f:
+            for b in f:
+                p = (R[box, i, 0] + a * (R[box, i, 1] - R[box, i, 0]), R[box, j, 0] + b * (R[box, j, 1] - R[box, j, 0]))
+                h = _sheet_height(paper_geometry, pc.models.pose[box], k, p)
+                if h is None:
+                    continue
+                assert (h >= R[box, k, 1] - 1e-9) if side else (h <= R[box, k, 0] + 1e-9), (box, side, p, h)
+                checked += 1
+        q = R[box, :, 0] + _GRID * (R[box, :, 1] - R[box, :, 0])
+        placed = placed_side(paper_geometry, pc.models, np.full(len(q), box), q)
+        assert not np.any(placed == (1 if side else -1)), (box, side)
+    assert checked >= 600, checked

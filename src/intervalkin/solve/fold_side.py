@@ -31,7 +31,7 @@ from intervalkin.kinematics.enclosures import det_a_gradient_interval, jacobian_
 from intervalkin.kinematics.fold_side import pair_side
 from intervalkin.solve.fold_model import SIDE_STEPS, FoldModels, krawczyk_image, normal_signs, preconditioned, side_of
 
-__all__ = ["pair_sides", "side_of_tight", "placed_side", "FoldSides", "PAIR", "GRID", "BISECTIONS"]
+__all__ = ["pair_sides", "side_of_tight", "placed_side", "empty_by_parts", "EMPTY_LEVELS", "FoldSides", "PAIR", "GRID", "BISECTIONS"]
 
 #: The signature change (count, n_wa1, n_wa2) from the piece below to the piece above when s = +1.
 PAIR = np.array([2, 1, 1], dtype=np.int64)
@@ -42,6 +42,8 @@ GRID = ((0.0, 0.0), (0.0, 1.0), (1.0, 0.0), (1.0, 1.0))
 TIGHT_STEPS = 2
 #: Bisection steps along a grid segment whose ends lie on either side of the box's middle height.
 BISECTIONS = 12
+#: Halvings of a fold box's parameter rectangle by :func:`empty_by_parts` (4 ** EMPTY_LEVELS parts at most).
+EMPTY_LEVELS = 4
 
 
 def _sheet_pose(geometry: Geometry, models: FoldModels, rows: np.ndarray, k: int, p: np.ndarray,
@@ -238,3 +240,74 @@ def placed_side(geometry: Geometry, models: FoldModels, box: np.ndarray, points:
     if near.size:  # the tight steps go on from the boxes the quick ones left
         side[near] = side_of_tight(geometry, models, np.asarray(box)[near], np.asarray(points)[near], poses[near])
     return side
+
+
+def empty_by_parts(geometry: Geometry, joint_boxes: np.ndarray, models: FoldModels, piece: np.ndarray,
+                   levels: int = EMPTY_LEVELS) -> np.ndarray:
+    """(n,) bool: the piece ``piece`` (n,) (0 below, 1 above) of each fold box (n, 3, 2) is proved empty.
+
+    The piece above, {q_k > h(p)}, is empty when h(p) >= hi_k for every p of the box's parameter rectangle, the
+    piece below when h(p) <= lo_k.  The rectangle is halved in both parameters, only where undecided, up to
+    ``levels`` times; over each part P a Krawczyk run with the parameter box P (the model's Y and C, then ones taken
+    again over the shrunk pose box) encloses X*(p) for every p in P (proofs/lemma-fold-joint-box.md, points 1, 5
+    and 6: each image holds every zero of E(.; p), p in P), so rho_k^2 over it encloses h^2 there.  A part where h
+    is proved on the piece's side of the face settles that part; one where h is proved off it (the piece reaches
+    into the box there) or where the run fails ends the box's attempt.  Certified.
+    """
+    R = np.asarray(joint_boxes, dtype=np.float64)
+    piece = np.asarray(piece, dtype=np.int64)
+    n = len(R)
+    out = np.zeros(n, dtype=bool)
+    open_ = np.ones(n, dtype=bool)  # no part found where the piece may reach
+    for k in range(3):
+        i, j = [a for a in range(3) if a != k]
+        rows = np.flatnonzero(models.ok & (models.axis == k))
+        # parts: (row, lo_i, hi_i, lo_j, hi_j), the whole rectangle first
+        part = rows
+        p_lo = np.stack([R[rows, i, 0], R[rows, j, 0]], axis=1)
+        p_hi = np.stack([R[rows, i, 1], R[rows, j, 1]], axis=1)
+        face_lo = Interval.point(R[:, k, 0]).sqr().lo  # lo_k^2 rounded down, hi_k^2 up: h beyond them is strict
+        face_hi = Interval.point(R[:, k, 1]).sqr().hi
+        for level in range(levels + 1):
+            if part.size == 0:
+                break
+            h2 = _part_heights(geometry, models, part, k, Interval(p_lo, p_hi))
+            with np.errstate(invalid="ignore"):
+                beyond = np.where(piece[part] == 1, h2.lo >= face_hi[part], h2.hi <= face_lo[part])
+                inside = np.where(piece[part] == 1, h2.hi < face_hi[part], h2.lo > face_lo[part])
+            lost = ~np.isfinite(h2.lo) | ~np.isfinite(h2.hi)
+            open_[part[inside | lost]] = False
+            if level == levels:
+                open_[part[~beyond]] = False
+                break
+            split = ~beyond & ~inside & ~lost & open_[part]
+            part, p_lo, p_hi = part[split], p_lo[split], p_hi[split]
+            mid = 0.5 * (p_lo + p_hi)
+            quarters = [(np.where(c, mid, p_lo), np.where(c, p_hi, mid))
+                        for c in (np.array([a, b], dtype=bool) for a in (0, 1) for b in (0, 1))]
+            part = np.tile(part, 4)
+            p_lo = np.concatenate([q[0] for q in quarters])
+            p_hi = np.concatenate([q[1] for q in quarters])
+        out[rows] = open_[rows]
+    return out
+
+
+def _part_heights(geometry: Geometry, models: FoldModels, rows: np.ndarray, k: int, P: Interval) -> Interval:
+    """Enclosures of h^2 over parameter boxes P (m, 2) of the models ``rows`` (axis k); NaN where a run failed."""
+    X = models.pose[rows].copy()
+    lost = np.zeros(len(rows), dtype=bool)
+    for step in range(SIDE_STEPS + TIGHT_STEPS):
+        if step < SIDE_STEPS:
+            Y, C = models.inv[rows], models.contraction[rows]
+        else:
+            Y, C = preconditioned((jacobian_interval(geometry, X), det_a_gradient_interval(geometry, X)), k)
+        K = krawczyk_image(geometry, X, k, P, Y, C)
+        fin = np.isfinite(K).all(axis=(1, 2))
+        # an image that failed leaves the box as it was (it holds X*(p) all the same)
+        Xn = np.where(fin[:, None, None], np.stack([np.maximum(X[:, :, 0], K[:, :, 0]),
+                                                      np.minimum(X[:, :, 1], K[:, :, 1])], axis=-1), X)
+        empty = (Xn[:, :, 0] > Xn[:, :, 1]).any(axis=1)  # cannot happen for a proved model: claim nothing there
+        lost |= empty
+        X = np.where(empty[:, None, None], X, Xn)
+    h2 = rho_sq_leg_interval(geometry, X, k)
+    return Interval(np.where(lost, np.nan, h2.lo), np.where(lost, np.nan, h2.hi))

@@ -31,7 +31,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
 from intervalkin.solve.fold_model import FoldModels
-from intervalkin.solve.fold_side import PAIR, pair_sides, placed_side
+from intervalkin.solve.fold_side import PAIR, empty_by_parts, pair_sides, placed_side
 
 __all__ = ["FoldPieces", "fold_pieces", "fold_sides", "placed_edges", "FACE_FRACTIONS", "PieceSignatures", "piece_signatures"]
 
@@ -195,7 +195,8 @@ def piece_signatures(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, pieces:
     from_cells (2 m, 3): the signature of each piece's cell, -1 where it has none.  For a box
     with one piece unknown, the side of the extra pair gives it: above = below + s (2, 1, 1)
     (proofs/lemma-fold-side.md); pieces joined by the piece graph share their signature (a
-    connected set off g(S)); a disagreement would be a soundness bug and is raised.  Certified.
+    connected set off g(S)); a disagreement would be a soundness bug and is raised.  A piece left
+    unknown is proved empty where it can be (:func:`~intervalkin.solve.fold_side.empty_by_parts`).  Certified.
     """
     m = len(pieces)
     n = len(lo)
@@ -239,4 +240,10 @@ def piece_signatures(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, pieces:
     bad = checked & ((sig[:, 1] - sig[:, 0]) != side[:, None].astype(np.int64) * PAIR).any(axis=1)
     if bad.any() or (sig < -1).any():
         raise AssertionError("a fold box's pieces disagree with the side of its extra pair (unsound)")
+    # a piece still unknown may be empty: the sheet stays beyond the box's face all along it
+    t, s = np.nonzero((sig[:, :, 0] < 0) & (empty == 0)[:, None])
+    if t.size:
+        boxes = np.stack([lo[pieces.box[t]], hi[pieces.box[t]]], axis=-1)
+        proved = empty_by_parts(geometry, boxes, pieces.models.take(t), s)
+        empty[t[proved]] = np.where(s[proved] == 1, 1, -1)
     return PieceSignatures(sig, empty, int(np.count_nonzero(sig[:, :, 0] >= 0)) - before)
