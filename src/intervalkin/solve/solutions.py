@@ -104,6 +104,15 @@ class DkpResult:
         """Number of listed solutions (the certified count only when ``complete``)."""
         return len(self.solutions)
 
+    @property
+    def signature(self) -> tuple[int, int, int] | None:
+        """(count, n_wa1, n_wa2) when the list is complete and every solution is proved non-singular with its
+        sign of det A (the signature of the joint vector, certified); None otherwise."""
+        if not self.complete or any(s.aspect not in ("WA1", "WA2") for s in self.solutions):
+            return None
+        n1 = sum(1 for s in self.solutions if s.aspect == "WA1")
+        return self.count, n1, self.count - n1
+
     def to_json(self) -> dict:
         """``{"rho", "count", "complete", "solutions"}`` as plain JSON types."""
         return {

@@ -100,11 +100,7 @@ class CellSolver:
 
     def _signature(self, lo: np.ndarray, hi: np.ndarray):
         witness = _exact_centre(lo, hi)
-        res = solve(self.geometry, witness)
-        if res.complete and all(s.aspect in ("WA1", "WA2") for s in res.solutions):
-            n1 = sum(1 for s in res.solutions if s.aspect == "WA1")
-            return (res.count, n1, res.count - n1), witness
-        return (-1, -1, -1), witness
+        return solve(self.geometry, witness).signature or (-1, -1, -1), witness
 
     def _face_edges(self, paving: Paving, fine_depth: int) -> np.ndarray:
         """The face-adjacent pairs of the paving's leaves; the last ones again when the leaves did not change."""

@@ -22,6 +22,7 @@ Node numbering of the piece graph: leaf b of the paving is node b; piece s (0 be
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 
@@ -30,6 +31,7 @@ from intervalkin.core.workers import Workers
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
+from intervalkin.solve.dkp import solve
 from intervalkin.solve.fold_model import FoldModels
 from intervalkin.solve.fold_side import PAIR, empty_by_parts, pair_sides, placed_side
 
@@ -196,7 +198,8 @@ def piece_signatures(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, pieces:
     with one piece unknown, the side of the extra pair gives it: above = below + s (2, 1, 1)
     (proofs/lemma-fold-side.md); pieces joined by the piece graph share their signature (a
     connected set off g(S)); a disagreement would be a soundness bug and is raised.  A piece left
-    unknown is proved empty where it can be (:func:`~intervalkin.solve.fold_side.empty_by_parts`).  Certified.
+    unknown gets its signature from a certified solve at its witness (one per group of joined pieces), else
+    is proved empty where it can be (:func:`~intervalkin.solve.fold_side.empty_by_parts`).  Certified.
     """
     m = len(pieces)
     n = len(lo)
@@ -219,8 +222,38 @@ def piece_signatures(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, pieces:
     a, b = e[0, pp] - n, e[1, pp] - n
     graph = csr_matrix((np.ones(a.size), (a, b)), shape=(2 * m, 2 * m))
     _, group = connected_components(graph, directed=False)
+    _spread(sig, side, group)
+    # a piece still unknown that holds a witness: one certified solve there gives its signature (the piece is
+    # connected and off g(S)), one solve per group of joined pieces
+    flat = sig.reshape(2 * m, 3)
+    open_ = np.flatnonzero((flat[:, 0] < 0) & np.isfinite(pieces.witness).all(axis=1))
+    _, first = np.unique(group[open_], return_index=True)
+    solved = False
+    for i in open_[first]:
+        got = solve(geometry, [Fraction(float(v)) for v in pieces.witness[i]]).signature
+        if got is not None:
+            flat[i] = got
+            solved = True
+    if solved:
+        _spread(sig, side, group)
+    checked = (sig[:, :, 0] >= 0).all(axis=1) & (side != 0)
+    bad = checked & ((sig[:, 1] - sig[:, 0]) != side[:, None].astype(np.int64) * PAIR).any(axis=1)
+    if bad.any() or (sig < -1).any():
+        raise AssertionError("a fold box's pieces disagree with the side of its extra pair (unsound)")
+    # a piece still unknown may be empty: the sheet stays beyond the box's face all along it
+    t, s = np.nonzero((sig[:, :, 0] < 0) & (empty == 0)[:, None])
+    if t.size:
+        boxes = np.stack([lo[pieces.box[t]], hi[pieces.box[t]]], axis=-1)
+        proved = empty_by_parts(geometry, boxes, pieces.models.take(t), s)
+        empty[t[proved]] = np.where(s[proved] == 1, 1, -1)
+    return PieceSignatures(sig, empty, int(np.count_nonzero(sig[:, :, 0] >= 0)) - before)
+
+
+def _spread(sig: np.ndarray, side: np.ndarray, group: np.ndarray) -> None:
+    """Signatures (m, 2, 3) spread in place: inside a box by the side of its extra pair, and to every piece of a
+    group of joined pieces; a disagreement is a soundness bug and is raised."""
+    m = len(sig)
     for _ in range(4):
-        flat = sig.reshape(2 * m, 3)
         for s, (src, dst) in ((1, (0, 1)), (-1, (1, 0))):
             # dst = src + s' (2, 1, 1) with s' the side read from src's point of view
             sel = (side != 0) & (sig[:, src, 0] >= 0) & (sig[:, dst, 0] < 0)
@@ -236,14 +269,3 @@ def piece_signatures(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, pieces:
         if not grow.any():
             break
         flat[grow] = rep[group[grow]]
-    checked = (sig[:, :, 0] >= 0).all(axis=1) & (side != 0)
-    bad = checked & ((sig[:, 1] - sig[:, 0]) != side[:, None].astype(np.int64) * PAIR).any(axis=1)
-    if bad.any() or (sig < -1).any():
-        raise AssertionError("a fold box's pieces disagree with the side of its extra pair (unsound)")
-    # a piece still unknown may be empty: the sheet stays beyond the box's face all along it
-    t, s = np.nonzero((sig[:, :, 0] < 0) & (empty == 0)[:, None])
-    if t.size:
-        boxes = np.stack([lo[pieces.box[t]], hi[pieces.box[t]]], axis=-1)
-        proved = empty_by_parts(geometry, boxes, pieces.models.take(t), s)
-        empty[t[proved]] = np.where(s[proved] == 1, 1, -1)
-    return PieceSignatures(sig, empty, int(np.count_nonzero(sig[:, :, 0] >= 0)) - before)
