@@ -89,9 +89,12 @@ def _sheet_height(geometry, pose_box, k, p):
     def E(X):
         rho = approx_inverse_kinematics(geometry, X)
         return np.array([rho[i] ** 2 - p[0] ** 2, rho[j] ** 2 - p[1] ** 2, approx_det_a(geometry, X)])
-    for _ in range(40):
+    for _ in range(12):
         J = np.stack([(E(X + h) - E(X - h)) / 2e-7 for h in np.eye(3) * 1e-7], axis=1)
-        X = X - np.linalg.solve(J, E(X))
+        step = np.linalg.solve(J, E(X))
+        X = X - step
+        if np.abs(step).max() < 1e-13:
+            break
     if np.abs(E(X)).max() > 1e-8 or np.any(X < pose_box[:, 0] - 1e-9) or np.any(X > pose_box[:, 1] + 1e-9):
         return None
     return approx_inverse_kinematics(geometry, X)[k]
@@ -99,7 +102,7 @@ def _sheet_height(geometry, pose_box, k, p):
 
 def test_pieces_proved_empty_by_parts_hold_no_sheet_point(paper_geometry, fold_paving, sides):
     """The parts' proof against float Newton: where the piece above is proved empty, h(p) >= hi_k at every point
-    of a 6 x 6 grid of the parameter rectangle (corners included), and h(p) <= lo_k where the piece below is; and
+    of a 5 x 5 grid of the parameter rectangle (corners included), and h(p) <= lo_k where the piece below is; and
     no grid point of the box is placed in it.  It proves pieces the monotone corner rule does not."""
     R, fs = sides
     pc = fold_paving.pieces
@@ -111,8 +114,8 @@ def test_pieces_proved_empty_by_parts_hold_no_sheet_point(paper_geometry, fold_p
     assert new.sum() >= 5, int(new.sum())
     rng = np.random.default_rng(12)
     checked = 0
-    f = np.linspace(0.0, 1.0, 6)
-    for r in rng.permutation(np.flatnonzero(proved))[:40]:
+    f = np.linspace(0.0, 1.0, 5)
+    for r in rng.permutation(np.flatnonzero(proved))[:24]:
         box, k, side = t[r], int(pc.models.axis[t[r]]), int(piece[r])
         i, j = [a for a in range(3) if a != k]
         for a in f:
@@ -126,4 +129,4 @@ def test_pieces_proved_empty_by_parts_hold_no_sheet_point(paper_geometry, fold_p
         q = R[box, :, 0] + _GRID * (R[box, :, 1] - R[box, :, 0])
         placed = placed_side(paper_geometry, pc.models, np.full(len(q), box), q)
         assert not np.any(placed == (1 if side else -1)), (box, side)
-    assert checked >= 600, checked
+    assert checked >= 300, checked
