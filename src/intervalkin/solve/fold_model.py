@@ -53,7 +53,7 @@ from intervalkin.kinematics.enclosures import (det_a_gradient_interval, jacobian
 from intervalkin.kinematics.point_enclosures import rho_sq_det_at
 from intervalkin.solve.pose_hull import pose_hulls
 
-__all__ = ["FoldModels", "fold_models", "side_of", "pose_hulls", "krawczyk_image", "normal_signs", "preconditioned", "SIDE_STEPS"]
+__all__ = ["FoldModels", "fold_models", "side_of", "pose_hulls", "krawczyk_image", "normal_signs", "height_slopes", "preconditioned", "SIDE_STEPS"]
 
 #: Krawczyk rounds before a box is given up: the first shrink the pose box to its intersection with
 #: the images, the last INFLATE_ROUNDS grow it to the hull of the box and the images (plus a margin).
@@ -187,6 +187,24 @@ def normal_signs(geometry: Geometry, K: np.ndarray) -> np.ndarray:
         m, n = (l + 1) % 3, (l + 2) % 3
         w = _cross(u[m][0], u[m][1], u[n][0], u[n][1])
         out[:, l] = np.where(w.lo > 0, 1, np.where(w.hi < 0, -1, 0))
+    return out
+
+
+def height_slopes(geometry: Geometry, models: FoldModels) -> np.ndarray:
+    """(m, 3) int8: the sign of dh/dr_l over the whole box for each axis l other than the model's axis k, 0
+    where not proved (and at l = k).  The sheet's normal at g(X) is (rho_1 w_1, rho_2 w_2, rho_3 w_3)
+    (module docstring), so dh/dr_l = -rho_l w_l / (rho_k w_k) and, with every rho > 0, its
+    sign is -sign(w_l) sign(w_k); the signs of w are certified over the Krawczyk box, which holds X*(p) for every
+    p of the box's face."""
+    m = len(models)
+    out = np.zeros((m, 3), dtype=np.int8)
+    rows = np.flatnonzero(models.ok & np.isfinite(models.pose).all(axis=(1, 2)))
+    if rows.size:
+        w = normal_signs(geometry, models.pose[rows]).astype(np.int64)
+        k = models.axis[rows].astype(np.int64)
+        slope = -w * w[np.arange(rows.size), k][:, None]
+        slope[np.arange(rows.size), k] = 0
+        out[rows] = slope
     return out
 
 

@@ -29,7 +29,8 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.enclosures import det_a_gradient_interval, jacobian_interval, rho_sq_leg_interval
 from intervalkin.kinematics.fold_side import pair_side
-from intervalkin.solve.fold_model import SIDE_STEPS, FoldModels, krawczyk_image, normal_signs, preconditioned, side_of
+from intervalkin.solve.fold_model import (SIDE_STEPS, FoldModels, height_slopes, krawczyk_image, preconditioned,
+                                          side_of)
 
 __all__ = ["pair_sides", "side_of_tight", "placed_side", "empty_by_parts", "EMPTY_LEVELS", "FoldSides", "PAIR", "GRID", "BISECTIONS"]
 
@@ -48,9 +49,10 @@ BISECTIONS = 12
 EMPTY_LEVELS = 6
 
 
-def _sheet_pose(geometry: Geometry, models: FoldModels, rows: np.ndarray, k: int, p: np.ndarray,
+def _sheet_pose(geometry: Geometry, models: FoldModels, rows: np.ndarray, k: int, p: np.ndarray | Interval,
                 tight: bool = True, start: np.ndarray | None = None) -> np.ndarray:
-    """Enclosures (m, 3, 2) of X*(p) for point parameters p (m, 2) of the models ``rows`` (axis k); NaN where lost.
+    """Enclosures (m, 3, 2) of X*(p) for point parameters p (m, 2) of the models ``rows`` (axis k), or of X*(p) for
+    every p in parameter boxes (an Interval (m, 2)); NaN where lost.
 
     Krawczyk steps with the model's preconditioner first, then (``tight``) TIGHT_STEPS with one recomputed
     over the current, smaller box (any preconditioner keeps every zero of the box, so each
@@ -58,7 +60,7 @@ def _sheet_pose(geometry: Geometry, models: FoldModels, rows: np.ndarray, k: int
     X*(p), as :func:`~intervalkin.solve.fold_model.side_of` returns them): only the recomputed steps are taken.
     """
     X = models.pose[rows].copy() if start is None else np.array(start, dtype=np.float64)
-    P = Interval.point(p)
+    P = p if isinstance(p, Interval) else Interval.point(p)
     first = 0 if start is None else SIDE_STEPS
     for step in range(first, SIDE_STEPS + (TIGHT_STEPS if tight else 0)):
         if step < SIDE_STEPS:
@@ -176,13 +178,12 @@ def _empty_pieces(geometry: Geometry, search: _Search, rows: np.ndarray, corners
     """
     k, R = search.k, search.R
     i, j = search.i, search.j
-    sg = normal_signs(geometry, search.models.pose[rows]).astype(np.int64)
-    at = np.flatnonzero((sg[:, i] != 0) & (sg[:, j] != 0) & (sg[:, k] != 0))
+    slope = height_slopes(geometry, search.models.take(rows))
+    at = np.flatnonzero((slope[:, i] != 0) & (slope[:, j] != 0))
     if at.size == 0:
         return
-    sg = sg[at]
-    # dh/dr_a = -rho_a w_a / (rho_k w_k): the corner where h is largest takes the upper end where it rises
-    rise = np.stack([-sg[:, i] * sg[:, k] > 0, -sg[:, j] * sg[:, k] > 0], axis=1)
+    # the corner where h is largest takes the upper end of each parameter along which it rises
+    rise = np.stack([slope[at, i] > 0, slope[at, j] > 0], axis=1)
     top_at = 2 * rise[:, 0] + rise[:, 1]  # the index of corner (a, b) in GRID is 2 a + b
     low_at = 3 - top_at
     lo2 = np.stack([c.lo[at] for c in corners], axis=1)
@@ -296,20 +297,7 @@ def empty_by_parts(geometry: Geometry, joint_boxes: np.ndarray, models: FoldMode
 
 def _part_heights(geometry: Geometry, models: FoldModels, rows: np.ndarray, k: int, P: Interval) -> Interval:
     """Enclosures of h^2 over parameter boxes P (m, 2) of the models ``rows`` (axis k); NaN where a run failed."""
-    X = models.pose[rows].copy()
-    lost = np.zeros(len(rows), dtype=bool)
-    for step in range(SIDE_STEPS + TIGHT_STEPS):
-        if step < SIDE_STEPS:
-            Y, C = models.inv[rows], models.contraction[rows]
-        else:
-            Y, C = preconditioned((jacobian_interval(geometry, X), det_a_gradient_interval(geometry, X)), k)
-        K = krawczyk_image(geometry, X, k, P, Y, C)
-        fin = np.isfinite(K).all(axis=(1, 2))
-        # an image that failed leaves the box as it was (it holds X*(p) all the same)
-        Xn = np.where(fin[:, None, None], np.stack([np.maximum(X[:, :, 0], K[:, :, 0]),
-                                                      np.minimum(X[:, :, 1], K[:, :, 1])], axis=-1), X)
-        empty = (Xn[:, :, 0] > Xn[:, :, 1]).any(axis=1)  # cannot happen for a proved model: claim nothing there
-        lost |= empty
-        X = np.where(empty[:, None, None], X, Xn)
-    h2 = rho_sq_leg_interval(geometry, X, k)
+    X = _sheet_pose(geometry, models, rows, k, P)
+    lost = ~np.isfinite(X).all(axis=(1, 2))
+    h2 = rho_sq_leg_interval(geometry, np.where(lost[:, None, None], 0.0, X), k)
     return Interval(np.where(lost, np.nan, h2.lo), np.where(lost, np.nan, h2.hi))

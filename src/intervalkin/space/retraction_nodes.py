@@ -16,7 +16,7 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
-from intervalkin.solve.fold_model import normal_signs
+from intervalkin.solve.fold_model import height_slopes
 from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
 from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, STEADY, base_signature, pair_direction_signs,
                                           pair_windows, window_kinds)
@@ -26,7 +26,7 @@ from intervalkin.solve.window_union import joined_windows
 from intervalkin.space.retraction_ranks import LEFT, RET, SINK
 
 __all__ = ["Nodes", "MAX_ROOTS", "MAX_PAIR_WINDOWS", "PAIR_HALVINGS", "DIRECTIONS", "MAX_OPTIONS", "EACH_FACE",
-           "clear_nodes", "fold_nodes", "fold_slopes", "window_nodes"]
+           "clear_nodes", "fold_nodes", "window_nodes"]
 
 #: f is a trigonometric polynomial of degree 3 (not identically 0): no joint vector has more solutions, so a
 #: node (a pattern, a cusp side, a window fold's piece) that would hold more is empty and is dropped.
@@ -167,13 +167,13 @@ def clear_nodes(jp, nodes: Nodes) -> None:
 def fold_nodes(jp, geometry: Geometry, nodes: Nodes) -> None:
     """The two pieces of each fold box.  The piece below (rho_k < h) leaves through its -e_k face, the piece
     above through its +e_k face; and where the slope dh/dr_l of the sheet is proved over the box
-    (:func:`fold_slopes`) also sideways: the piece below along the direction in which h rises, the piece above
+    (:func:`~intervalkin.solve.fold_model.height_slopes`) also sideways: the piece below along the direction in which h rises, the piece above
     along the one in which it falls (rho_k stays fixed, so it stays on its side of the graph)."""
     pieces, sigs = jp.pieces, jp.piece_signatures
     if pieces is None or not len(pieces) or sigs is None:
         return
     axis = pieces.models.axis.astype(np.int64)
-    slope = fold_slopes(geometry, pieces.models)
+    slope = height_slopes(geometry, pieces.models)
     for side in (0, 1):  # below: towards -e_k; above: towards +e_k
         keep = sigs.empty != (-1 if side == 0 else 1)
         s = sigs.signature[keep, side]
@@ -181,24 +181,6 @@ def fold_nodes(jp, geometry: Geometry, nodes: Nodes) -> None:
         faces = _faces_of_axis(slope[keep], np.int64(1 - 2 * side))
         faces[np.arange(faces.shape[0]), 2 * axis[keep] + side] = True
         nodes.add(pieces.box[keep], s, _kind(cell, s), 1, cell, _single_faces(faces))
-
-
-def fold_slopes(geometry: Geometry, models) -> np.ndarray:
-    """(m, 3) int8: the sign of dh/dr_l over the whole box for each axis l other than the model's axis k, 0
-    where not proved (and at l = k).  The sheet's normal at g(X) is (rho_1 w_1, rho_2 w_2, rho_3 w_3)
-    (:mod:`intervalkin.solve.fold_model`), so dh/dr_l = -rho_l w_l / (rho_k w_k) and, with every rho > 0, its
-    sign is -sign(w_l) sign(w_k); the signs of w are certified over the Krawczyk box, which holds X*(p) for every
-    p of the box's face."""
-    m = len(models)
-    out = np.zeros((m, 3), dtype=np.int8)
-    rows = np.flatnonzero(models.ok & np.isfinite(models.pose).all(axis=(1, 2)))
-    if rows.size:
-        w = normal_signs(geometry, models.pose[rows]).astype(np.int64)
-        k = models.axis[rows].astype(np.int64)
-        slope = -w * w[np.arange(rows.size), k][:, None]
-        slope[np.arange(rows.size), k] = 0
-        out[rows] = slope
-    return out
 
 
 def window_nodes(jp, geometry: Geometry, nodes: Nodes, workers: Workers | None = None) -> np.ndarray:
