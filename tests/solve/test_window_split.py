@@ -19,7 +19,9 @@
   boxes and pieces, near the zeros of D as well (a slope with the D^2 term dropped, or the factor 2 on s lost,
   fails);
 - ``denominator_enclosure`` (with its monotone hull) holds D at sampled points of each piece, and signs
-  the pieces that end next to a zero of D.
+  the pieces that end next to a zero of D;
+- ``branch_slopes`` holds the phi-slopes of the branches s -+ D sqrt(V) (arb) on tiny boxes, and where
+  ``simple_on_branches`` says a piece holds no double root, sampled points keep one sign of each slope.
 """
 
 from __future__ import annotations
@@ -282,3 +284,73 @@ def test_root_direction_signs_hold_at_the_roots_beside_the_zeros_of_d(which, pap
     assert roots >= 40, roots
     if which == "paper":  # on the second design |D| sqrt(V) stays far above what the s-term allows: no sign
         assert proved >= roots and beyond >= 20, (roots, proved, beyond)
+
+
+def _branch_slopes(geometry, r, phi, h=1e-7):
+    """(g_+', g_-', V, D) at (phi, r) in arb, g_+- = s -+ D sqrt(V): central differences at 170 bits."""
+    def g(p):
+        _, _, s, leg, d = _arb_parts(geometry, r, p)
+        k = arb(float(r[1])) - arb(float(r[0])) - leg / 4
+        v = arb(float(r[0])) * leg - k * k
+        root = v.sqrt() if v > 0 else arb(0)
+        return s - d * root, s + d * root, v, d
+    up, down, mid = g(phi + h), g(phi - h), g(phi)
+    run = arb(phi + h) - arb(phi - h)
+    return (float(((up[0] - down[0]) / run).mid()), float(((up[1] - down[1]) / run).mid()),
+            float(mid[2].mid()), float(mid[3].mid()))
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_branch_slopes_hold_and_simple_on_branches_keeps_one_sign(which, paper_geometry, second_geometry, rng):
+    """g_+- = s -+ D sqrt(V), the two branches of f near the zeros of D.  On tiny boxes and pieces, the
+    enclosures of branch_slopes hold g_+-' (arb, central differences at 170 bits) at their centres: with
+    V' = L' (r_1 - k / 2) instead of L' (r_1 + k / 2), or the D V' term dropped, they miss it.  On boxes and
+    pieces of the paving's sizes, where simple_on_branches says a piece holds no double root, sampled points
+    have V > 0, D != 0 and one sign of each g_+-'; on the paper's manipulator it says so of pieces that
+    root_direction_signs can neither sign nor call rootless (the pieces it is there for)."""
+    from intervalkin.solve.window_split import branch_slopes, simple_on_branches
+
+    geometry = paper_geometry if which == "paper" else second_geometry
+    lo_j, hi_j = float(max(geometry.rho_min)), float(min(geometry.rho_max))
+    zeros = d_zeros(geometry)
+
+    def sample(m, box_exp, piece_exp):
+        centre = rng.uniform(lo_j, hi_j, (m, 3))
+        width = 10 ** rng.uniform(*box_exp, (m, 1))
+        phi = zeros[rng.integers(0, 2, m)] + rng.choice([-1, 1], m) * 10 ** rng.uniform(-2.5, -1, m)
+        half = 10 ** rng.uniform(*piece_exp, m)
+        return np.stack([centre - width, centre + width], axis=2), phi - half, phi + half
+
+    boxes, lo, hi = sample(400, (-8, -7), (-9, -8))
+    ok, plus, minus = branch_slopes(geometry, boxes, np.arange(len(lo)), lo, hi)
+    held = 0
+    with ctx.workprec(170):
+        for i in np.flatnonzero(ok)[:40]:
+            rho = boxes[i].mean(axis=1)
+            p = 0.5 * (lo[i] + hi[i])
+            gp, gm, v, d = _branch_slopes(geometry, rho ** 2, p)
+            assert v > 0 and d != 0
+            for value, enc in ((gp, plus), (gm, minus)):
+                slack = 1e-6 * (abs(value) + 1e-9)  # the central difference's own error
+                assert enc.lo[i] - slack <= value <= enc.hi[i] + slack, (i, value, enc.lo[i], enc.hi[i])
+            held += 1
+    assert held >= 20, held
+
+    boxes, lo, hi = sample(3000, (-2.5, -1), (-4, -2.5))
+    owner = np.arange(len(lo))
+    said = simple_on_branches(geometry, boxes, owner, lo, hi)
+    checked = 0
+    with ctx.workprec(170):
+        for i in np.flatnonzero(said)[:15]:
+            seen = set()
+            for _ in range(5):
+                rho = rng.uniform(boxes[i, :, 0], boxes[i, :, 1])
+                gp, gm, v, d = _branch_slopes(geometry, rho ** 2, float(rng.uniform(lo[i], hi[i])))
+                assert v > 0 and d != 0, (i, v, d)
+                seen.add((np.sign(gp), np.sign(gm)))
+            assert len(seen) == 1 and 0 not in next(iter(seen)), (i, seen)
+            checked += 1
+    assert checked >= 10, (which, int(said.sum()))
+    if which == "paper":
+        signs, rootless = root_direction_signs(geometry, boxes, owner, lo, hi, DIRECTIONS)
+        assert (said & ~rootless & ~(signs != 0).any(axis=1)).sum() >= 5

@@ -47,7 +47,7 @@ from intervalkin.core.interval import Interval, sign_label
 from intervalkin.core.workers import Workers
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_count import window_signature
-from intervalkin.solve.window_split import aligned_r_slopes, root_direction_signs
+from intervalkin.solve.window_split import aligned_r_slopes, root_direction_signs, simple_on_branches
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced",
@@ -262,6 +262,9 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     every point of it).  The window folds need the sign at every point of the critical pieces (u monotone), so
     it is off for them.
 
+    With ``at_roots`` a critical piece also says nothing where no point of it is a double root of f (u vanishes
+    only at one; :func:`~intervalkin.solve.window_split.simple_on_branches`: the two branches of f near a zero of D).
+
     ``workers``: boxes are cut into parts computed at once (each window's signs come from its own box alone, so
     the arrays are the same bit for bit)."""
     w = len(models.degree)
@@ -289,6 +292,7 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     root = np.zeros((pw.size, len(directions)), dtype=np.int8)
     if at_roots:
         root, quiet = root_direction_signs(geometry, models.boxes[rows], owner, lo, hi, directions)
+        quiet |= simple_on_branches(geometry, models.boxes[rows], owner, lo, hi)
     signs = np.zeros((pw.size, len(directions)), dtype=np.int8)
     for c, e in enumerate(directions):
         sg = sign_label(grad[0] * e[0] + grad[1] * e[1] + grad[2] * e[2]).astype(np.int8)

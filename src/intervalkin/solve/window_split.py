@@ -33,6 +33,7 @@ from intervalkin.kinematics.reduced_equation import aligned_numerator, denominat
 from intervalkin.solve.simple_roots import trig_basis
 
 __all__ = ["denominator_enclosure", "gap_positive", "line_misses_circle", "aligned_r_slopes", "root_direction_signs",
+           "simple_on_branches", "branch_slopes",
            "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
 
 #: Half-width of the gap cut around each zero of D in a D-open window.
@@ -161,6 +162,46 @@ def _integer_combinations(lo: np.ndarray, hi: np.ndarray, e: np.ndarray) -> Inte
         c_lo, c_hi = c_lo - margin, c_hi + margin
     bad = ~(np.isfinite(c_lo) & np.isfinite(c_hi))
     return Interval(np.where(bad, -np.inf, c_lo), np.where(bad, np.inf, c_hi))
+
+
+def simple_on_branches(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
+                       hi: np.ndarray) -> np.ndarray:
+    """(m,) bool: no point of R^2 x [lo, hi], R = boxes[owner], is a double root of f (proofs/lemma-branch-roots.md).
+
+    Where the line of legs 1 and 2 meets the circle of leg 1 (V > 0 proved) and D != 0, f L = s^2 - D^2 V is the
+    product of the two branches g_+- = s -+ D sqrt(V), smooth in phi, never zero together.  A double root of f is
+    then a double root of one branch, and there is none when both slopes g_+-' (:func:`branch_slopes`) have one
+    strict sign over the piece.  Close to a zero of D the root bound of :func:`root_direction_signs` cannot sign
+    D_e f (s takes both signs at the roots), but a pattern of pair windows changes only where u = min s f
+    vanishes, at a double root: pieces proved free of those say nothing about the directions."""
+    ok, plus, minus = branch_slopes(geometry, boxes, owner, lo, hi)
+    return ok & (sign_label(plus) != 0) & (sign_label(minus) != 0)
+
+
+def branch_slopes(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
+                  hi: np.ndarray) -> tuple[np.ndarray, Interval, Interval]:
+    """((m,) bool, the rows where V > 0, L > 0 and D != 0 are proved over R^2 x [lo, hi]; there, enclosures of
+    g_+-' = s' -+ (D' sqrt(V) + D V' / (2 sqrt(V))), with V' = L' (r_1 + k / 2) since V = r_1 L - k^2 and
+    k = r_2 - r_1 - L / 4 (elsewhere meaningless))."""
+    aligned = aligned_numerator(geometry)
+    phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
+    _, leg, _, d, k, r = _aligned_terms(geometry, boxes, owner, lo, hi)
+    v = r[0] * leg - k.sqr()
+    ok = certainly_positive(v) & certainly_positive(leg) & (sign_label(d) != 0)
+    basis = trig_basis(phi, 1)
+    coef = basis.matmul(Ball.from_interval(aligned.coefficients))
+    s_phi = coef[:, 0]
+    for i in range(3):
+        s_phi = s_phi + coef[:, 1 + i] * Ball.from_interval(r[i])
+    s_phi = s_phi.to_interval()
+    leg_phi = basis.matmul(Ball.from_interval(Interval(aligned.leg_square.lo[:, None],
+                                                       aligned.leg_square.hi[:, None])))[:, 0].to_interval()
+    c, sn = cos_sin_multiple(phi, 1, 1)  # d/dphi of (cos phi, sin phi)
+    dd = Ball.from_interval(denominator(geometry))
+    d_phi = (dd[1] * c + dd[2] * sn).to_interval()
+    root_v = Interval(np.where(ok, v.lo, 1.0), np.where(ok, v.hi, 1.0)).sqrt()
+    branch = d_phi * root_v + d * (leg_phi * (r[0] + k * 0.5)) / (root_v * 2.0)
+    return ok, s_phi - branch, s_phi + branch
 
 
 #: Pieces per block in :func:`root_direction_signs` (its arrays are pieces x directions).
