@@ -17,7 +17,7 @@
   sign flipped, or |s| bounded by |D| V / 1000 instead of |D| sqrt(V), it fails;
 - ``aligned_r_slopes`` holds df/dr_l (arb, by a central difference at 170 bits) at sampled points of random
   boxes and pieces, near the zeros of D as well (a slope with the D^2 term dropped, or the factor 2 on s lost,
-  fails);
+  fails; so does a centred form of s, c_l and L without its slope term);
 - ``denominator_enclosure`` (with its monotone hull) holds D at sampled points of each piece, and signs
   the pieces that end next to a zero of D;
 - ``branch_slopes`` holds the phi-slopes of the branches s -+ D sqrt(V) (arb) on tiny boxes, and where

@@ -30,7 +30,7 @@ from intervalkin.core.ball import Ball, cos_sin_multiple
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, Interval, certainly_negative, certainly_positive, sign_label
 from intervalkin.kinematics.reduced_equation import aligned_numerator, denominator
-from intervalkin.solve.simple_roots import trig_basis
+from intervalkin.solve.simple_roots import basis_waves, trig_basis
 
 __all__ = ["denominator_enclosure", "gap_positive", "line_misses_circle", "aligned_r_slopes", "root_direction_signs",
            "simple_on_branches", "branch_slopes",
@@ -110,20 +110,38 @@ def line_misses_circle(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray,
 
 
 def _aligned_terms(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray):
-    """Over R^2 x [lo, hi], R = boxes[owner]: (ds/dr_l (m, 3) balls, L, s, D, k_2, r_i) of f L = s^2 - D^2 V."""
+    """Over R^2 x [lo, hi], R = boxes[owner]: (ds/dr_l (m, 3) balls, L, s, D, k_2, r_i) of f L = s^2 - D^2 V.
+
+    s, its r-slopes and L are each the intersection of the natural form and the centred form in phi,
+    X(phi_m) + X'(Phi) (Phi - phi_m) (proofs/lemma-mean-value-form.md): the natural form pays the amplitude of every
+    harmonic times the piece's width, the centred form only the slope's range, which is far smaller where the
+    harmonics cancel (near the zeros of D the amplitudes of s are thousands of times its size)."""
     aligned = aligned_numerator(geometry)
     phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
-    basis = trig_basis(phi)
-    coef = basis.matmul(Ball.from_interval(aligned.coefficients))
-    leg = basis.matmul(Ball.from_interval(Interval(aligned.leg_square.lo[:, None],
-                                                   aligned.leg_square.hi[:, None])))[:, 0].to_interval()
+    waves = basis_waves(phi.mid)
+    natural, at_mid, slope = (trig_basis(x, d, waves) for x, d in ((phi, 0), (Ball.point(phi.mid), 0), (phi, 1)))
+    step = Ball(np.zeros_like(phi.mid), phi.rad)[:, None]
     box = np.asarray(boxes, dtype=np.float64)[owner]
     r = [Interval(box[:, i, 0], box[:, i, 1]).sqr() for i in range(3)]
-    s = coef[:, 0]
-    for i in range(3):
-        s = s + coef[:, 1 + i] * Ball.from_interval(r[i])
+    r_balls = [Ball.from_interval(x) for x in r]
+
+    def tight(coef: Interval) -> tuple[Ball, Ball, Ball]:
+        c = Ball.from_interval(coef)
+        return natural.matmul(c), at_mid.matmul(c), slope.matmul(c)
+
+    def affine(cols: Ball) -> Ball:  # c_0 + sum_i c_i r_i over the box
+        out = cols[:, 0]
+        for i in range(3):
+            out = out + cols[:, 1 + i] * r_balls[i]
+        return out
+
+    nat, mid, der = tight(aligned.coefficients)
+    slopes = Ball.from_interval((mid[:, 1:] + der[:, 1:] * step).to_interval().intersect(nat[:, 1:].to_interval()))
+    s = (affine(mid) + affine(der) * step[:, 0]).to_interval().intersect(affine(nat).to_interval())
+    nat, mid, der = tight(Interval(aligned.leg_square.lo[:, None], aligned.leg_square.hi[:, None]))
+    leg = (mid + der * step).to_interval().intersect(nat.to_interval())[:, 0]
     k = r[1] - r[0] - leg * 0.25
-    return coef[:, 1:], leg, s.to_interval(), denominator_enclosure(geometry, lo, hi), k, r
+    return slopes, leg, s, denominator_enclosure(geometry, lo, hi), k, r
 
 
 def aligned_r_slopes(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
