@@ -73,21 +73,11 @@ def gap_positive(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: n
     """(m,) bool: f > 0 proved over R^2 x [lo, hi], R = boxes[owner], by f >= s^2 / |m_2|^2 - r_1 D^2
     (:func:`intervalkin.kinematics.reduced_equation.aligned_numerator`): the bound that sees f = |N|^2 > 0 near a zero of D,
     where the Taylor form of f cancels.  s is affine in r, so its range over R^2 is enclosed as a product of
-    balls; everything is outward-rounded."""
-    aligned = aligned_numerator(geometry)
-    phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
-    basis = trig_basis(phi)  # (m, 7)
-    coef = basis.matmul(Ball.from_interval(aligned.coefficients))  # (m, 4): s = c_0 + sum_i c_i r_i
-    leg = basis.matmul(Ball.from_interval(Interval(aligned.leg_square.lo[:, None], aligned.leg_square.hi[:, None])))
-    box = np.asarray(boxes, dtype=np.float64)[owner]
-    r = [Interval(box[:, i, 0], box[:, i, 1]).sqr() for i in range(3)]
-    s = coef[:, 0]
-    for i in range(3):
-        s = s + coef[:, 1 + i] * Ball.from_interval(r[i])
-    leg_i = leg[:, 0].to_interval()
-    positive_leg = certainly_positive(leg_i)
-    bound = s.to_interval().sqr() / Interval(np.where(positive_leg, leg_i.lo, 1.0), np.where(positive_leg, leg_i.hi, 1.0))
-    bound = bound - r[0] * denominator_enclosure(geometry, lo, hi).sqr()
+    balls (s and |m_2|^2 by the centred and natural forms of :func:`_aligned_terms`); everything is outward-rounded."""
+    _, leg, s, d, _, r = _aligned_terms(geometry, boxes, owner, lo, hi)
+    positive_leg = certainly_positive(leg)
+    bound = s.sqr() / Interval(np.where(positive_leg, leg.lo, 1.0), np.where(positive_leg, leg.hi, 1.0))
+    bound = bound - r[0] * d.sqr()
     return positive_leg & certainly_positive(bound)
 
 
@@ -99,14 +89,9 @@ def line_misses_circle(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray,
     With L = |m_2|^2 and k_2 = r_2 - r_1 - L / 4, f L = s^2 - D^2 V where V = r_1 L - k_2^2 (s = m_2 x N): V < 0
     and D != 0 give f >= D^2 |V| / L > 0.  A box enclosure of f misses it where the terms of f cancel; V's
     enclosure is a few interval operations on L, which has one harmonic."""
-    aligned = aligned_numerator(geometry)
-    phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
-    leg = trig_basis(phi).matmul(Ball.from_interval(Interval(aligned.leg_square.lo[:, None],
-                                                             aligned.leg_square.hi[:, None])))[:, 0].to_interval()
-    box = np.asarray(boxes, dtype=np.float64)[owner]
-    r1, r2 = (Interval(box[:, i, 0], box[:, i, 1]).sqr() for i in range(2))
-    v = r1 * leg - (r2 - r1 - leg * 0.25).sqr()
-    return certainly_negative(v) & (sign_label(denominator_enclosure(geometry, lo, hi)) != 0)
+    _, leg, _, d, k, r = _aligned_terms(geometry, boxes, owner, lo, hi)
+    v = r[0] * leg - k.sqr()
+    return certainly_negative(v) & (sign_label(d) != 0)
 
 
 def _aligned_terms(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray):
