@@ -21,7 +21,9 @@
 - ``denominator_enclosure`` (with its monotone hull) holds D at sampled points of each piece, and signs
   the pieces that end next to a zero of D;
 - ``branch_slopes`` holds the phi-slopes of the branches s -+ D sqrt(V) (arb) on tiny boxes, and where
-  ``simple_on_branches`` says a piece holds no double root, sampled points keep one sign of each slope.
+  ``simple_on_branches`` says a piece holds no double root, sampled points keep one sign of each slope;
+- ``double_root_signs`` at double roots of f beside the zeros of D (float Newton): never says their pieces hold
+  none, and every sign it proves is that of D_e f there (arb).
 """
 
 from __future__ import annotations
@@ -354,3 +356,71 @@ def test_branch_slopes_hold_and_simple_on_branches_keeps_one_sign(which, paper_g
     if which == "paper":
         signs, rootless = root_direction_signs(geometry, boxes, owner, lo, hi, DIRECTIONS)
         assert (said & ~rootless & ~(signs != 0).any(axis=1)).sum() >= 5
+
+
+def _fold_points(geometry, rng, count):
+    """(phi, r) pairs near the zeros of D where f(.; r) has a double root at phi (float Newton on (F, F') in (r_1,
+    r_2) with phi and r_3 fixed, F = f |m_2|^2): the points where a pair of roots is born."""
+    from scipy.optimize import fsolve
+
+    lo_j, hi_j = float(max(geometry.rho_min)), float(min(geometry.rho_max))
+    zeros = d_zeros(geometry)
+    out = []
+    for _ in range(40 * count):
+        phi = zeros[rng.integers(0, 2)] + rng.choice([-1, 1]) * 10 ** rng.uniform(-2.3, -1)
+        r3 = rng.uniform(lo_j, hi_j) ** 2
+
+        def eqs(x):
+            r = np.array([x[0], x[1], r3])
+            h = 1e-6
+            grid = np.array([phi - h, phi, phi + h])
+            f = _float_f_times_leg(geometry, r, grid)
+            return [f[1], (f[2] - f[0]) / (2 * h)]
+        x, _, done, _ = fsolve(eqs, rng.uniform(lo_j, hi_j, 2) ** 2, full_output=True)
+        r = np.array([x[0], x[1], r3])
+        if done == 1 and np.all((lo_j ** 2 < r) & (r < hi_j ** 2)) and abs(eqs(x)[0]) < 1e-6:
+            out.append((phi, r))
+            if len(out) == count:
+                break
+    return out
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_double_root_signs_hold_at_the_folds_beside_the_zeros_of_d(which, paper_geometry, second_geometry, rng):
+    """At double roots of f near the zeros of D (the folds where a pair of roots is born; float Newton), boxes and
+    pieces around them are never said to hold no double root, and every sign double_root_signs proves there is
+    the sign of D_e f (arb, central differences in r at 170 bits).  With the sigma^2 term of Q dropped, or the
+    sign of its D^2 V' term reversed, it fails; it proves signs that root_direction_signs does not."""
+    from intervalkin.solve.window_split import double_root_signs
+
+    geometry = paper_geometry if which == "paper" else second_geometry
+    folds = _fold_points(geometry, rng, 30)
+    assert len(folds) >= 15, len(folds)
+    proved = beyond = 0
+    with ctx.workprec(170):
+        for phi, r in folds:
+            rho = np.sqrt(r)
+            width = 10 ** rng.uniform(-3, -1.3)
+            box = np.stack([rho - rng.uniform(0, width, 3), rho + rng.uniform(0, width, 3)], axis=1)[None]
+            lo, hi = phi - 10 ** rng.uniform(-5, -3), phi + 10 ** rng.uniform(-5, -3)
+            one = np.zeros(1, dtype=np.int64)
+            signs, none = double_root_signs(geometry, box, one, np.array([lo]), np.array([hi]), DIRECTIONS)
+            assert not none[0], "a piece holding a double root of f called free of them"
+            old, _ = root_direction_signs(geometry, box, one, np.array([lo]), np.array([hi]), DIRECTIONS)
+            grad = []
+            for axis in range(3):
+                step = np.zeros(3)
+                step[axis] = 1e-6
+                up = _arb_parts(geometry, r + step, phi)[0]
+                down = _arb_parts(geometry, r - step, phi)[0]
+                run = arb(float((r + step)[axis])) - arb(float((r - step)[axis]))
+                grad.append(2 * rho[axis] * float(((up - down) / run).mid()))
+            scale = np.abs(grad).sum()
+            for c, e in enumerate(DIRECTIONS):
+                value = float(np.dot(e, grad))
+                if signs[0, c] == 0 or abs(value) < 1e-6 * scale:
+                    continue
+                proved += 1
+                beyond += old[0, c] == 0
+                assert np.sign(value) == signs[0, c], (phi, r, e, value, signs[0, c])
+    assert proved >= 100 and beyond >= 20, (proved, beyond)

@@ -47,7 +47,8 @@ from intervalkin.core.interval import Interval, sign_label
 from intervalkin.core.workers import Workers
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_count import window_signature
-from intervalkin.solve.window_split import aligned_r_slopes, root_direction_signs, simple_on_branches
+from intervalkin.solve.window_split import (aligned_r_slopes, double_root_signs, root_direction_signs,
+                                          simple_on_branches)
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced",
@@ -293,6 +294,12 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     if at_roots:
         root, quiet = root_direction_signs(geometry, models.boxes[rows], owner, lo, hi, directions)
         quiet |= simple_on_branches(geometry, models.boxes[rows], owner, lo, hi)
+        need = np.flatnonzero(~quiet & (root == 0).any(axis=1))
+        double, no_double = double_root_signs(geometry, models.boxes[rows], owner[need], lo[need], hi[need],
+                                              directions)
+        # both signs hold at a double root: opposite ones prove the piece holds none
+        quiet[need] |= no_double | (root[need].astype(np.int64) * double < 0).any(axis=1)
+        root[need] = np.where(root[need] != 0, root[need], double)
     signs = np.zeros((pw.size, len(directions)), dtype=np.int8)
     for c, e in enumerate(directions):
         sg = sign_label(grad[0] * e[0] + grad[1] * e[1] + grad[2] * e[2]).astype(np.int8)

@@ -17,7 +17,9 @@ Two kinds of windows of :mod:`intervalkin.solve.window_model` are not certified 
 Three bounds read f through f |m_2|^2 = s^2 - D^2 V (proofs/lemma-line-misses-circle.md), where its terms do
 not cancel: :func:`line_misses_circle` settles pieces f > 0 where the line of legs 1 and 2 misses the circle of
 leg 1, :func:`aligned_r_slopes` encloses df/dr_l near the zeros of D, where the Taylor form cannot sign it, and
-:func:`root_direction_signs` encloses it at the roots of f alone, where |s| = |D| sqrt(V).
+:func:`root_direction_signs` encloses it at the roots of f alone, where |s| = |D| sqrt(V).  At the double roots
+alone, :func:`double_root_signs` pins s further by the phi-derivative of f L, and :func:`simple_on_branches` proves
+pieces free of them where f L splits into the branches s -+ D sqrt(V).
 
 Everything here is vectorised over windows, pieces and brackets.
 """
@@ -33,7 +35,7 @@ from intervalkin.kinematics.reduced_equation import aligned_numerator, denominat
 from intervalkin.solve.simple_roots import basis_waves, trig_basis
 
 __all__ = ["denominator_enclosure", "gap_positive", "line_misses_circle", "aligned_r_slopes", "root_direction_signs",
-           "simple_on_branches", "branch_slopes",
+           "simple_on_branches", "branch_slopes", "double_root_signs", "S_PARTS",
            "D_GAP", "D_HALVINGS", "d_zeros", "cut_at_d_zeros", "sub_windows", "root_d_signs", "sign_changes"]
 
 #: Half-width of the gap cut around each zero of D in a D-open window.
@@ -186,25 +188,106 @@ def branch_slopes(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: 
     """((m,) bool, the rows where V > 0, L > 0 and D != 0 are proved over R^2 x [lo, hi]; there, enclosures of
     g_+-' = s' -+ (D' sqrt(V) + D V' / (2 sqrt(V))), with V' = L' (r_1 + k / 2) since V = r_1 L - k^2 and
     k = r_2 - r_1 - L / 4 (elsewhere meaningless))."""
-    aligned = aligned_numerator(geometry)
-    phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
     _, leg, _, d, k, r = _aligned_terms(geometry, boxes, owner, lo, hi)
     v = r[0] * leg - k.sqr()
     ok = certainly_positive(v) & certainly_positive(leg) & (sign_label(d) != 0)
+    s_phi, v_phi, d_phi = _phi_slopes(geometry, lo, hi, r, k)
+    root_v = Interval(np.where(ok, v.lo, 1.0), np.where(ok, v.hi, 1.0)).sqrt()
+    branch = d_phi * root_v + d * v_phi / (root_v * 2.0)
+    return ok, s_phi - branch, s_phi + branch
+
+
+def _phi_slopes(geometry: Geometry, lo: np.ndarray, hi: np.ndarray, r: list[Interval],
+                k: Interval) -> tuple[Interval, Interval, Interval]:
+    """(s', V', D') over R^2 x [lo, hi] (' = d/dphi; r the enclosures of r_i over R^2, k of k_2): the derivative
+    basis times the aligned coefficients, V' = L' (r_1 + k / 2) (lemma-branch-roots.md, part 3)."""
+    aligned = aligned_numerator(geometry)
+    phi = Ball.from_interval(Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)))
     basis = trig_basis(phi, 1)
     coef = basis.matmul(Ball.from_interval(aligned.coefficients))
     s_phi = coef[:, 0]
     for i in range(3):
         s_phi = s_phi + coef[:, 1 + i] * Ball.from_interval(r[i])
-    s_phi = s_phi.to_interval()
     leg_phi = basis.matmul(Ball.from_interval(Interval(aligned.leg_square.lo[:, None],
                                                        aligned.leg_square.hi[:, None])))[:, 0].to_interval()
     c, sn = cos_sin_multiple(phi, 1, 1)  # d/dphi of (cos phi, sin phi)
     dd = Ball.from_interval(denominator(geometry))
-    d_phi = (dd[1] * c + dd[2] * sn).to_interval()
-    root_v = Interval(np.where(ok, v.lo, 1.0), np.where(ok, v.hi, 1.0)).sqrt()
-    branch = d_phi * root_v + d * (leg_phi * (r[0] + k * 0.5)) / (root_v * 2.0)
-    return ok, s_phi - branch, s_phi + branch
+    return s_phi.to_interval(), leg_phi * (r[0] + k * 0.5), (dd[1] * c + dd[2] * sn).to_interval()
+
+
+#: Parts of each sign's range of s in :func:`double_root_signs`.
+S_PARTS = 16
+
+
+def double_root_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                      directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """At the DOUBLE roots of f only: ((m, c) int8, the sign of D_e f there (0: not proved), (m,) bool, the pieces
+    proved to hold none), for pieces where D != 0 is proved (others: 0 and False).  lemma-double-root-s.md:
+    at a double root s^2 = D^2 V and (f L)' = 0, so s is a zero of
+
+        Q(sigma) = 2 sigma s' - 2 (D' / D) sigma^2 - D^2 V'
+
+    in the root bound's range of s; the parts of that range (each sign's side cut in :data:`S_PARTS`) where an
+    enclosure of Q holds 0 bound s at the double roots far more tightly than |s| <= |D| sqrt(V), and
+    L D_e f = 2 s D_e s - D^2 D_e V is signed over each sign's hull of them."""
+    directions = np.asarray(directions, dtype=np.int64)
+    m = len(owner)
+    signs = np.zeros((m, len(directions)), dtype=np.int8)
+    none = np.zeros(m, dtype=bool)
+    for a in range(0, m, _ROOT_BLOCK):
+        part = slice(a, min(a + _ROOT_BLOCK, m))
+        signs[part], none[part] = _double_block(geometry, boxes, owner[part], lo[part], hi[part], directions)
+    return signs, none
+
+
+def _double_block(geometry, boxes, owner, lo, hi, directions):
+    slopes, leg, s, d, k, r = _aligned_terms(geometry, boxes, owner, lo, hi)
+    m = len(owner)
+    v = r[0] * leg - k.sqr()
+    bound = (Interval(np.zeros(m), np.maximum(v.hi, 0.0)).sqrt()
+             * Interval(np.zeros(m), np.maximum(np.abs(d.lo), np.abs(d.hi)))).hi
+    s_lo, s_hi = np.maximum(s.lo, -bound), np.minimum(s.hi, bound)
+    ok = (sign_label(d) != 0) & certainly_positive(leg)
+    signs = np.zeros((m, len(directions)), dtype=np.int8)
+    none = ok & ~(s_lo <= s_hi)  # no root at all
+    live = np.flatnonzero(ok & (s_lo <= s_hi))
+    if not live.size:
+        return signs, none
+    s_phi, v_phi, d_phi = _phi_slopes(geometry, lo[live], hi[live], [x[live] for x in r], k[live])
+    dl = d[live]
+    ratio = (d_phi / dl) * 2.0
+    const = dl.sqr() * v_phi
+    hulls = []
+    for side in (-1, 1):  # sigma <= 0, sigma >= 0: the sign of s at the double root
+        a = np.where(side < 0, s_lo[live], np.maximum(s_lo[live], 0.0))
+        b = np.where(side < 0, np.minimum(s_hi[live], 0.0), s_hi[live])
+        grid = a[:, None] + (b - a)[:, None] * (np.arange(S_PARTS + 1) / S_PARTS)[None, :]
+        grid[:, -1] = b  # the parts cover [a, b] exactly: consecutive parts share their float ends
+        sigma = Interval(np.minimum(grid[:, :-1], grid[:, 1:]), np.maximum(grid[:, :-1], grid[:, 1:]))
+        col = lambda x: Interval(x.lo[:, None], x.hi[:, None])  # noqa: E731
+        q = sigma * col(s_phi) * 2.0 - sigma.sqr() * col(ratio) - col(const)
+        keep = (q.lo <= 0) & (q.hi >= 0) & (a <= b)[:, None]
+        h_lo = np.where(keep, sigma.lo, np.inf).min(axis=1)
+        h_hi = np.where(keep, sigma.hi, -np.inf).max(axis=1)
+        hulls.append((keep.any(axis=1), h_lo, h_hi))
+    none[live] = ~hulls[0][0] & ~hulls[1][0]
+    box = np.asarray(boxes, dtype=np.float64)[owner[live]]
+    rho2 = [Interval(2.0 * box[:, i, 0], 2.0 * box[:, i, 1]) for i in range(3)]
+    ds = [slopes[live, i].to_interval() * rho2[i] for i in range(3)]
+    lv, kv = leg[live], k[live]
+    dv = [(lv + kv * 2.0) * rho2[0], kv * -2.0 * rho2[1]]
+    de_s = _integer_combinations(np.column_stack([x.lo for x in ds]), np.column_stack([x.hi for x in ds]), directions)
+    de_v = _integer_combinations(np.column_stack([x.lo for x in dv]), np.column_stack([x.hi for x in dv]),
+                                 directions[:, :2])
+    d2 = dl.sqr()
+    term = Interval(d2.lo[:, None], d2.hi[:, None]) * de_v
+    agreed = np.full((live.size, len(directions)), 2, dtype=np.int64)  # 2: no side seen yet
+    for held, h_lo, h_hi in hulls:
+        sg = sign_label(Interval(np.where(held, h_lo, 0.0)[:, None], np.where(held, h_hi, 0.0)[:, None]) * de_s * 2.0
+                        - term).astype(np.int64)
+        agreed = np.where(~held[:, None], agreed, np.where((agreed == 2) | (agreed == sg), sg, 0))
+    signs[live] = np.where(np.abs(agreed) == 1, agreed, 0)
+    return signs, none
 
 
 #: Pieces per block in :func:`root_direction_signs` (its arrays are pieces x directions).
