@@ -36,8 +36,9 @@ from intervalkin.kinematics.reduced_equation import HARMONICS, aligned_numerator
 from intervalkin.kinematics.sextic import laurent_value, reduction
 from intervalkin.core.interval import Interval
 from intervalkin.kinematics.reduced_equation import denominator
+from intervalkin.solve.root_directions import root_direction_signs
 from intervalkin.solve.window_split import (D_GAP, aligned_r_slopes, d_zeros, denominator_enclosure, gap_positive,
-                                          line_misses_circle, root_direction_signs)
+                                          line_misses_circle)
 from intervalkin.space.retraction_nodes import DIRECTIONS
 
 
@@ -310,7 +311,7 @@ def test_branch_slopes_hold_and_simple_on_branches_keeps_one_sign(which, paper_g
     pieces of the paving's sizes, where simple_on_branches says a piece holds no double root, sampled points
     have V > 0, D != 0 and one sign of each g_+-'; on the paper's manipulator it says so of pieces that
     root_direction_signs can neither sign nor call rootless (the pieces it is there for)."""
-    from intervalkin.solve.window_split import branch_slopes, simple_on_branches
+    from intervalkin.solve.root_directions import branch_slopes, simple_on_branches
 
     geometry = paper_geometry if which == "paper" else second_geometry
     lo_j, hi_j = float(max(geometry.rho_min)), float(min(geometry.rho_max))
@@ -391,7 +392,7 @@ def test_double_root_signs_hold_at_the_folds_beside_the_zeros_of_d(which, paper_
     pieces around them are never said to hold no double root, and every sign double_root_signs proves there is
     the sign of D_e f (arb, central differences in r at 170 bits).  With the sigma^2 term of Q dropped, or the
     sign of its D^2 V' term reversed, it fails; it proves signs that root_direction_signs does not."""
-    from intervalkin.solve.window_split import double_root_signs
+    from intervalkin.solve.root_directions import double_root_signs
 
     geometry = paper_geometry if which == "paper" else second_geometry
     folds = _fold_points(geometry, rng, 30)

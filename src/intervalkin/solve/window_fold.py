@@ -47,8 +47,8 @@ from intervalkin.core.interval import Interval, sign_label
 from intervalkin.core.workers import Workers
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_count import window_signature
-from intervalkin.solve.window_split import (aligned_r_slopes, double_root_signs, root_direction_signs,
-                                          simple_on_branches)
+from intervalkin.solve.root_directions import double_root_signs, root_direction_signs, simple_on_branches
+from intervalkin.solve.window_split import aligned_r_slopes
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced",
@@ -257,14 +257,14 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     ``at_roots``: the sign only at the roots of f on the critical pieces, which is all the retraction needs (u
     changes sign only through u = 0, where its minimum is a double root; proofs/lemma-joint-retraction.md): where
     the whole-piece form gives none, the sign at the roots of
-    :func:`~intervalkin.solve.window_split.root_direction_signs`; critical pieces proved to hold no root (or whose
+    :func:`~intervalkin.solve.root_directions.root_direction_signs`; critical pieces proved to hold no root (or whose
     two forms disagree, which they could not at a root) then say nothing, and a window whose critical pieces all
     hold none gets :data:`STEADY` for every direction (u does not vanish on the box, so its status is the same at
     every point of it).  The window folds need the sign at every point of the critical pieces (u monotone), so
     it is off for them.
 
     With ``at_roots`` a critical piece also says nothing where no point of it is a double root of f (u vanishes
-    only at one; :func:`~intervalkin.solve.window_split.simple_on_branches`: the two branches of f near a zero of D).
+    only at one; :func:`~intervalkin.solve.root_directions.simple_on_branches`: the two branches of f near a zero of D).
 
     ``workers``: boxes are cut into parts computed at once (each window's signs come from its own box alone, so
     the arrays are the same bit for bit)."""
