@@ -60,19 +60,34 @@ def root_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarra
 def _root_block(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
                 directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     slopes, leg, s, d, k, r = aligned_terms(geometry, boxes, owner, lo, hi)
-    box = np.asarray(boxes, dtype=np.float64)[owner]
-    v = r[0] * leg - k.sqr()
-    bound = (Interval(np.zeros(len(owner)), np.maximum(v.hi, 0.0)).sqrt()
-             * Interval(np.zeros(len(owner)), np.maximum(np.abs(d.lo), np.abs(d.hi)))).hi
-    s_lo, s_hi = np.maximum(s.lo, -bound), np.minimum(s.hi, bound)
+    s_lo, s_hi, bound = _s_at_roots(leg, s, d, k, r)
     rootless = ~(s_lo <= s_hi)
     signs = np.zeros((len(owner), len(directions)), dtype=np.int8)
     # where the bound does not narrow s, this is aligned_r_slopes' enclosure again: not worth a second time
     tight = np.flatnonzero(~rootless & (bound < np.maximum(np.abs(s.lo), np.abs(s.hi))))
     if not tight.size:
         return signs, rootless
-    slopes, leg, d, k, box = slopes[tight], leg[tight], d[tight], k[tight], box[tight]
-    at_root = Interval(s_lo[tight][:, None], s_hi[tight][:, None])
+    de_s, d2_de_v = _direction_terms(np.asarray(boxes, dtype=np.float64)[owner[tight]], slopes[tight], leg[tight],
+                                     d[tight], k[tight], directions)
+    value = Interval(s_lo[tight][:, None], s_hi[tight][:, None]) * de_s * 2.0 - d2_de_v
+    signs[tight] = np.where(certainly_positive(leg[tight])[:, None], sign_label(value), 0)
+    return signs, rootless
+
+
+def _s_at_roots(leg: Interval, s: Interval, d: Interval, k: Interval,
+                r: list[Interval]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(lo, hi) of s's range cut to [-B, B], B = max |D| sqrt(max(V, 0)) (|s| = |D| sqrt(V) at a root), and B."""
+    v = r[0] * leg - k.sqr()
+    m = len(v.lo)
+    bound = (Interval(np.zeros(m), np.maximum(v.hi, 0.0)).sqrt()
+             * Interval(np.zeros(m), np.maximum(np.abs(d.lo), np.abs(d.hi)))).hi
+    return np.maximum(s.lo, -bound), np.minimum(s.hi, bound), bound
+
+
+def _direction_terms(box: np.ndarray, slopes: Ball, leg: Interval, d: Interval, k: Interval,
+                     directions: np.ndarray) -> tuple[Interval, Interval]:
+    """(m, c) enclosures of D_e s and of D^2 D_e V over the boxes (D_e = sum_l e_l 2 rho_l d/dr_l), with
+    dV/dr_1 = L + 2 k, dV/dr_2 = -2 k, dV/dr_3 = 0 (lemma-line-misses-circle.md, statement 3)."""
     rho2 = [Interval(2.0 * box[:, i, 0], 2.0 * box[:, i, 1]) for i in range(3)]
     ds = [slopes[:, i].to_interval() * rho2[i] for i in range(3)]
     dv = [(leg + k * 2.0) * rho2[0], k * -2.0 * rho2[1]]
@@ -80,9 +95,7 @@ def _root_block(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np
     de_v = _integer_combinations(np.column_stack([x.lo for x in dv]), np.column_stack([x.hi for x in dv]),
                                  directions[:, :2])
     d2 = d.sqr()
-    value = at_root * de_s * 2.0 - Interval(d2.lo[:, None], d2.hi[:, None]) * de_v
-    signs[tight] = np.where(certainly_positive(leg)[:, None], sign_label(value), 0)
-    return signs, rootless
+    return de_s, Interval(d2.lo[:, None], d2.hi[:, None]) * de_v
 
 
 def _integer_combinations(lo: np.ndarray, hi: np.ndarray, e: np.ndarray) -> Interval:
@@ -173,10 +186,7 @@ def double_root_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, 
 def _double_block(geometry, boxes, owner, lo, hi, directions):
     slopes, leg, s, d, k, r = aligned_terms(geometry, boxes, owner, lo, hi)
     m = len(owner)
-    v = r[0] * leg - k.sqr()
-    bound = (Interval(np.zeros(m), np.maximum(v.hi, 0.0)).sqrt()
-             * Interval(np.zeros(m), np.maximum(np.abs(d.lo), np.abs(d.hi)))).hi
-    s_lo, s_hi = np.maximum(s.lo, -bound), np.minimum(s.hi, bound)
+    s_lo, s_hi, _ = _s_at_roots(leg, s, d, k, r)
     ok = (sign_label(d) != 0) & certainly_positive(leg)
     signs = np.zeros((m, len(directions)), dtype=np.int8)
     none = ok & ~(s_lo <= s_hi)  # no root at all
@@ -194,27 +204,21 @@ def _double_block(geometry, boxes, owner, lo, hi, directions):
         grid = a[:, None] + (b - a)[:, None] * (np.arange(S_PARTS + 1) / S_PARTS)[None, :]
         grid[:, -1] = b  # the parts cover [a, b] exactly: consecutive parts share their float ends
         sigma = Interval(np.minimum(grid[:, :-1], grid[:, 1:]), np.maximum(grid[:, :-1], grid[:, 1:]))
-        col = lambda x: Interval(x.lo[:, None], x.hi[:, None])  # noqa: E731
-        q = sigma * col(s_phi) * 2.0 - sigma.sqr() * col(ratio) - col(const)
+        q = sigma * _column(s_phi) * 2.0 - sigma.sqr() * _column(ratio) - _column(const)
         keep = (q.lo <= 0) & (q.hi >= 0) & (a <= b)[:, None]
-        h_lo = np.where(keep, sigma.lo, np.inf).min(axis=1)
-        h_hi = np.where(keep, sigma.hi, -np.inf).max(axis=1)
-        hulls.append((keep.any(axis=1), h_lo, h_hi))
+        hulls.append((keep.any(axis=1), np.where(keep, sigma.lo, np.inf).min(axis=1),
+                      np.where(keep, sigma.hi, -np.inf).max(axis=1)))
     none[live] = ~hulls[0][0] & ~hulls[1][0]
-    box = np.asarray(boxes, dtype=np.float64)[owner[live]]
-    rho2 = [Interval(2.0 * box[:, i, 0], 2.0 * box[:, i, 1]) for i in range(3)]
-    ds = [slopes[live, i].to_interval() * rho2[i] for i in range(3)]
-    lv, kv = leg[live], k[live]
-    dv = [(lv + kv * 2.0) * rho2[0], kv * -2.0 * rho2[1]]
-    de_s = _integer_combinations(np.column_stack([x.lo for x in ds]), np.column_stack([x.hi for x in ds]), directions)
-    de_v = _integer_combinations(np.column_stack([x.lo for x in dv]), np.column_stack([x.hi for x in dv]),
-                                 directions[:, :2])
-    d2 = dl.sqr()
-    term = Interval(d2.lo[:, None], d2.hi[:, None]) * de_v
+    de_s, d2_de_v = _direction_terms(np.asarray(boxes, dtype=np.float64)[owner[live]], slopes[live], leg[live], dl,
+                                     k[live], directions)
     agreed = np.full((live.size, len(directions)), 2, dtype=np.int64)  # 2: no side seen yet
     for held, h_lo, h_hi in hulls:
-        sg = sign_label(Interval(np.where(held, h_lo, 0.0)[:, None], np.where(held, h_hi, 0.0)[:, None]) * de_s * 2.0
-                        - term).astype(np.int64)
+        at = Interval(np.where(held, h_lo, 0.0)[:, None], np.where(held, h_hi, 0.0)[:, None])
+        sg = sign_label(at * de_s * 2.0 - d2_de_v).astype(np.int64)
         agreed = np.where(~held[:, None], agreed, np.where((agreed == 2) | (agreed == sg), sg, 0))
     signs[live] = np.where(np.abs(agreed) == 1, agreed, 0)
     return signs, none
+
+
+def _column(x: Interval) -> Interval:
+    return Interval(x.lo[:, None], x.hi[:, None])

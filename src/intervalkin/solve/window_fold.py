@@ -264,7 +264,9 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     it is off for them.
 
     With ``at_roots`` a critical piece also says nothing where no point of it is a double root of f (u vanishes
-    only at one; :func:`~intervalkin.solve.root_directions.simple_on_branches`: the two branches of f near a zero of D).
+    only at one: :mod:`~intervalkin.solve.root_directions`, the two branches of f near a zero of D, and s pinned
+    at the double roots), and where the root bound leaves a direction open, the sign at the double roots alone
+    fills it (:func:`~intervalkin.solve.root_directions.double_root_signs`).
 
     ``workers``: boxes are cut into parts computed at once (each window's signs come from its own box alone, so
     the arrays are the same bit for bit)."""
