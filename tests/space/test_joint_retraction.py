@@ -274,14 +274,14 @@ def test_the_summary_reports_the_retraction(fold_paving, retraction):
     assert "retraction" not in fold_paving.open_places()
 
 
-def _window_count(geometry, point, lo: float, hi: float) -> int | None:
-    """The number of solutions at an exact point whose phi lies in [lo, hi] (mod 2 pi), by an independent certified
-    solve; None where it does not complete."""
+def _window_count(geometry, point, lo: np.ndarray, hi: np.ndarray) -> int | None:
+    """The number of solutions at an exact point whose phi lies in one of the pieces [lo_j, hi_j] (mod 2 pi; a
+    window's pieces may run across -pi), by an independent certified solve; None where it does not complete."""
     res = solve(geometry, [Fraction(float(x)) for x in point])
     if not res.complete or any(s.status != "unique" for s in res.solutions):
         return None
     phis = [float(np.mean(s.box[2])) for s in res.solutions]
-    return sum(any(lo <= p + k * 2 * np.pi <= hi for k in (-1, 0, 1)) for p in phis)
+    return sum(any(a <= p + k * 2 * np.pi <= b for k in (-1, 0, 1) for a, b in zip(lo, hi)) for p in phis)
 
 
 def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_geometry):
@@ -298,11 +298,10 @@ def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_ge
     win = fold_paving.windows
     models = split_at_zeros_of_d(paper_geometry, joined_windows(win.models)).models
     # a sample of the boxes with a pair window beside a zero of D, where the signs at the roots tell most
-    w_lo = np.full(len(models.degree), np.inf)
-    w_hi = np.full(len(models.degree), -np.inf)
-    np.minimum.at(w_lo, models.piece_window, models.piece_lo)
-    np.maximum.at(w_hi, models.piece_window, models.piece_hi)
-    gap = np.min([np.maximum(np.maximum(w_lo - z, z - w_hi), 0) for z in d_zeros(paper_geometry)], axis=0)
+    apart = np.min([np.maximum(np.maximum(models.piece_lo - z, z - models.piece_hi), 0)
+                    for z in d_zeros(paper_geometry)], axis=0)  # each piece's distance to the zeros of D
+    gap = np.full(len(models.degree), np.inf)
+    np.minimum.at(gap, models.piece_window, apart)
     near = np.unique(models.window_box[pair_windows(models) & (gap < 0.1) & models.ok[models.window_box]])
     rng = np.random.default_rng(17)
     rows = np.sort(rng.choice(near, size=min(near.size, 2500), replace=False))
@@ -317,7 +316,9 @@ def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_ge
         box = models.boxes[models.window_box[w]]
         c = rng.choice(np.flatnonzero((old[w] == 0) & (new[w] != 0)))
         x = box[:, 0] + rng.random(3) * (box[:, 1] - box[:, 0])
-        status = _window_count(paper_geometry, x, w_lo[w], w_hi[w])
+        own = models.piece_window == w
+        pieces = models.piece_lo[own], models.piece_hi[own]
+        status = _window_count(paper_geometry, x, *pieces)
         if status is None:
             continue
         assert status in (0, 2)
@@ -326,7 +327,7 @@ def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_ge
         reach = min(np.min(np.where(e > 0, (box[:, 1] - x) / np.where(e > 0, e, 1), np.inf)),
                     np.min(np.where(e < 0, (box[:, 0] - x) / np.where(e < 0, e, -1), np.inf)))
         for t in (0.2, 0.4, 0.6, 0.8, 1.0):
-            got = _window_count(paper_geometry, np.clip(x + t * reach * e, box[:, 0], box[:, 1]), w_lo[w], w_hi[w])
+            got = _window_count(paper_geometry, np.clip(x + t * reach * e, box[:, 0], box[:, 1]), *pieces)
             assert got is None or got == status, (w, DIRECTIONS[c], way, t, status, got)
         checked += 1
         steady += bool(new[w, c] == STEADY)
