@@ -131,7 +131,7 @@ def branch_slopes(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: 
     """((m,) bool, the rows where V > 0, L > 0 and D != 0 are proved over R^2 x [lo, hi]; there, enclosures of
     g_+-' = s' -+ (D' sqrt(V) + D V' / (2 sqrt(V))), with V' = L' (r_1 + k / 2) since V = r_1 L - k^2 and
     k = r_2 - r_1 - L / 4 (elsewhere meaningless))."""
-    _, leg, _, d, k, r = aligned_terms(geometry, boxes, owner, lo, hi)
+    _, leg, _, d, k, r = aligned_terms(geometry, boxes, owner, lo, hi, with_s=False, with_slopes=False)
     v = r[0] * leg - k.sqr()
     ok = certainly_positive(v) & certainly_positive(leg) & (sign_label(d) != 0)
     s_phi, v_phi, d_phi = _phi_slopes(geometry, lo, hi, r, k)

@@ -73,7 +73,7 @@ def gap_positive(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: n
     (:func:`intervalkin.kinematics.reduced_equation.aligned_numerator`): the bound that sees f = |N|^2 > 0 near a zero of D,
     where the Taylor form of f cancels.  s is affine in r, so its range over R^2 is enclosed as a product of
     balls (s and |m_2|^2 by the centred and natural forms of :func:`aligned_terms`); everything is outward-rounded."""
-    _, leg, s, d, _, r = aligned_terms(geometry, boxes, owner, lo, hi)
+    _, leg, s, d, _, r = aligned_terms(geometry, boxes, owner, lo, hi, with_slopes=False)
     positive_leg = certainly_positive(leg)
     bound = s.sqr() / Interval(np.where(positive_leg, leg.lo, 1.0), np.where(positive_leg, leg.hi, 1.0))
     bound = bound - r[0] * d.sqr()
@@ -88,13 +88,15 @@ def line_misses_circle(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray,
     With L = |m_2|^2 and k_2 = r_2 - r_1 - L / 4, f L = s^2 - D^2 V where V = r_1 L - k_2^2 (s = m_2 x N): V < 0
     and D != 0 give f >= D^2 |V| / L > 0.  A box enclosure of f misses it where the terms of f cancel; V's
     enclosure is a few interval operations on L, which has one harmonic."""
-    _, leg, _, d, k, r = aligned_terms(geometry, boxes, owner, lo, hi)
+    _, leg, _, d, k, r = aligned_terms(geometry, boxes, owner, lo, hi, with_s=False, with_slopes=False)
     v = r[0] * leg - k.sqr()
     return certainly_negative(v) & (sign_label(d) != 0)
 
 
-def aligned_terms(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray):
-    """Over R^2 x [lo, hi], R = boxes[owner]: (ds/dr_l (m, 3) balls, L, s, D, k_2, r_i) of f L = s^2 - D^2 V.
+def aligned_terms(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                  with_s: bool = True, with_slopes: bool = True):
+    """Over R^2 x [lo, hi], R = boxes[owner]: (ds/dr_l (m, 3) balls, L, s, D, k_2, r_i) of f L = s^2 - D^2 V
+    (the r-slopes and s are None when not asked for: the bounds on L and k alone skip them).
 
     s, its r-slopes and L are each the intersection of the natural form and the centred form in phi,
     X(phi_m) + X'(Phi) (Phi - phi_m) (proofs/lemma-mean-value-form.md): the natural form pays the amplitude of every
@@ -119,9 +121,14 @@ def aligned_terms(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: 
             out = out + cols[:, 1 + i] * r_balls[i]
         return out
 
-    nat, mid, der = tight(aligned.coefficients)
-    slopes = Ball.from_interval((mid[:, 1:] + der[:, 1:] * step).to_interval().intersect(nat[:, 1:].to_interval()))
-    s = (affine(mid) + affine(der) * step[:, 0]).to_interval().intersect(affine(nat).to_interval())
+    slopes = s = None
+    if with_s or with_slopes:
+        nat, mid, der = tight(aligned.coefficients)
+        if with_slopes:
+            slopes = Ball.from_interval((mid[:, 1:] + der[:, 1:] * step).to_interval()
+                                        .intersect(nat[:, 1:].to_interval()))
+        if with_s:
+            s = (affine(mid) + affine(der) * step[:, 0]).to_interval().intersect(affine(nat).to_interval())
     nat, mid, der = tight(Interval(aligned.leg_square.lo[:, None], aligned.leg_square.hi[:, None]))
     leg = (mid + der * step).to_interval().intersect(nat.to_interval())[:, 0]
     k = r[1] - r[0] - leg * 0.25
