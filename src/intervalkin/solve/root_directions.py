@@ -190,7 +190,7 @@ def _double_block(geometry, boxes, owner, lo, hi, directions):
     ok = (sign_label(d) != 0) & certainly_positive(leg)
     signs = np.zeros((m, len(directions)), dtype=np.int8)
     none = ok & ~(s_lo <= s_hi)  # no root at all
-    live = np.flatnonzero(ok & (s_lo <= s_hi))
+    live = np.flatnonzero(ok & (s_lo <= s_hi) & np.isfinite(s_lo) & np.isfinite(s_hi))
     if not live.size:
         return signs, none
     s_phi, v_phi, d_phi = _phi_slopes(geometry, lo[live], hi[live], [x[live] for x in r], k[live])
@@ -205,7 +205,7 @@ def _double_block(geometry, boxes, owner, lo, hi, directions):
         grid[:, -1] = b  # the parts cover [a, b] exactly: consecutive parts share their float ends
         sigma = Interval(np.minimum(grid[:, :-1], grid[:, 1:]), np.maximum(grid[:, :-1], grid[:, 1:]))
         q = sigma * _column(s_phi) * 2.0 - sigma.sqr() * _column(ratio) - _column(const)
-        keep = (q.lo <= 0) & (q.hi >= 0) & (a <= b)[:, None]
+        keep = ~((q.lo > 0) | (q.hi < 0)) & (a <= b)[:, None]  # dropped only where Q is proved nonzero (not NaN)
         hulls.append((keep.any(axis=1), np.where(keep, sigma.lo, np.inf).min(axis=1),
                       np.where(keep, sigma.hi, -np.inf).max(axis=1)))
     none[live] = ~hulls[0][0] & ~hulls[1][0]
