@@ -45,16 +45,23 @@ def root_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarra
     of D, where a root has s near 0 but the piece's range of s does not, the intersection is far narrower, and
     where it is empty no point of the piece is a root.  Then L D_e f = 2 s D_e s - D^2 D_e V (statement 3), with
     one s for every axis, and L > 0 where it is proved."""
+    return _in_blocks("root_direction_signs", _root_block, geometry, boxes, owner, lo, hi, directions)
+
+
+def _in_blocks(name: str, block, geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+               directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``block`` over runs of :data:`_ROOT_BLOCK` pieces (its arrays are pieces x directions); the directions'
+    entries must lie in -2..2, which keeps the products of :func:`_integer_combinations` exact."""
     directions = np.asarray(directions, dtype=np.int64)
     if directions.size and np.abs(directions).max() > 2:
-        raise ValueError("root_direction_signs: direction entries must lie in -2..2 (their products are exact)")
+        raise ValueError(f"{name}: direction entries must lie in -2..2 (their products are exact)")
     m = len(owner)
     signs = np.zeros((m, len(directions)), dtype=np.int8)
-    rootless = np.zeros(m, dtype=bool)
+    flags = np.zeros(m, dtype=bool)
     for a in range(0, m, _ROOT_BLOCK):
         part = slice(a, min(a + _ROOT_BLOCK, m))
-        signs[part], rootless[part] = _root_block(geometry, boxes, owner[part], lo[part], hi[part], directions)
-    return signs, rootless
+        signs[part], flags[part] = block(geometry, boxes, owner[part], lo[part], hi[part], directions)
+    return signs, flags
 
 
 def _root_block(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -173,14 +180,7 @@ def double_root_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, 
     in the root bound's range of s; the parts of that range (each sign's side cut in :data:`S_PARTS`) where an
     enclosure of Q holds 0 bound s at the double roots far more tightly than |s| <= |D| sqrt(V), and
     L D_e f = 2 s D_e s - D^2 D_e V is signed over each sign's hull of them."""
-    directions = np.asarray(directions, dtype=np.int64)
-    m = len(owner)
-    signs = np.zeros((m, len(directions)), dtype=np.int8)
-    none = np.zeros(m, dtype=bool)
-    for a in range(0, m, _ROOT_BLOCK):
-        part = slice(a, min(a + _ROOT_BLOCK, m))
-        signs[part], none[part] = _double_block(geometry, boxes, owner[part], lo[part], hi[part], directions)
-    return signs, none
+    return _in_blocks("double_root_signs", _double_block, geometry, boxes, owner, lo, hi, directions)
 
 
 def _double_block(geometry, boxes, owner, lo, hi, directions):
