@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 from flint import arb, ctx, fmpq
 
+from intervalkin.core.interval import Interval
 from intervalkin.kinematics.sextic import laurent_value, reduction
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_fold import CLEAR, FOLD, extreme_corners, fold_piece
@@ -195,3 +196,42 @@ def test_r_slope_encloses_the_derivative(paper_geometry, windows):
                 assert float(d.mid()) - float(d.rad()) >= enc.lo[0] and float(d.mid()) + float(d.rad()) <= enc.hi[0]
             checked += 1
     assert checked == 120
+
+
+def test_direction_signs_hold_exactly_in_blocks_and_agree_with_interval_sums(rng):
+    """The retraction's direction signs (integer directions, two matrix products per end, taken in row blocks):
+    where a sign is proved, the exact rational sum sum_l e_l x_l at sampled points of the boxes has it, for
+    grads of very different magnitudes, one infinite end and a NaN; and they match the direction-by-direction
+    interval sums except where a sum is within rounding of 0 (rows whose x_1 and x_2 are one float apart make
+    such sums).  Fails if a block is skipped or misaligned."""
+    from intervalkin.solve.window_fold import _SIGN_BLOCK, _direction_signs
+    from intervalkin.space.retraction_nodes import DIRECTIONS
+
+    m = 2 * _SIGN_BLOCK + 37  # three blocks, the last one short
+    scale = 10.0 ** rng.integers(-3, 6, size=(m, 1))
+    lo = rng.normal(size=(m, 3)) * scale
+    hi = lo + np.abs(rng.normal(size=(m, 3))) * scale * rng.choice([0.0, 1e-12, 0.1], size=(m, 3))
+    # rows where e = (1, -1, 0) cancels to within one ulp: x_1 and x_2 points one float apart
+    near = rng.choice(m, 300, replace=False)
+    lo[near, 1] = np.nextafter(lo[near, 0], np.inf)
+    hi[near, :2] = lo[near, :2]
+    lo[5, 2], hi[6, 0], lo[7, 1] = -np.inf, np.inf, np.nan
+    grad = [Interval(lo[:, i], hi[:, i]) for i in range(3)]
+    got = _direction_signs(grad, DIRECTIONS.astype(float))
+    assert got.shape == (m, len(DIRECTIONS)) and got.dtype == np.int8
+    assert not got[5].any() and not got[6].any() and not got[7].any()  # a non-finite end proves nothing
+    with np.errstate(invalid="ignore"):  # inf * 0 in the reference: NaN, no sign
+        ref = np.column_stack([np.where((g := grad[0] * e[0] + grad[1] * e[1] + grad[2] * e[2]).lo > 0, 1,
+                                        np.where(g.hi < 0, -1, 0)) for e in DIRECTIONS.astype(float)])
+    differ = got != ref
+    assert differ.sum() <= 0.01 * got.size, "the blocked sums lost far more signs than rounding explains"
+    rows = np.r_[near[:50], rng.choice(m, 200, replace=False)]
+    for i in rows:
+        if not np.isfinite(lo[i]).all() or not np.isfinite(hi[i]).all():
+            continue
+        for t in (0.0, 1.0, rng.random()):
+            x = [Fraction(float(a)) + (Fraction(float(b)) - Fraction(float(a))) * Fraction(t).limit_denominator(1000)
+                 for a, b in zip(lo[i], hi[i])]
+            for c, e in enumerate(DIRECTIONS):
+                v = sum(int(e[l]) * x[l] for l in range(3))
+                assert got[i, c] == 0 or (v > 0 if got[i, c] > 0 else v < 0), (i, e, v, got[i, c])
