@@ -11,13 +11,21 @@ from intervalkin.solve.dkp import solve
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_cusp import AXIS_PAIRS, cusp_retractions, cusp_windows
 from intervalkin.solve.window_fold import base_signature
+from intervalkin.solve.window_union import joined_windows
 
 
-@pytest.fixture(scope="module")
-def lifted(fold_paving, paper_geometry):
+@pytest.fixture(scope="module", params=[3, 4], ids=["degree-3", "union-of-degree-4"])
+def lifted(fold_paving, paper_geometry, request):
+    """The cusp windows of the models (degree 3), or the unions of runs with Rolle bound 4 that the retraction
+    reads as cusp windows too (``joined_windows(max_degree=4)``; only rows whose cusp window is such a union)."""
     models = fold_paving.windows.models
+    if request.param == 4:
+        models = joined_windows(models, max_degree=4)
     cusp = cusp_windows(models)
-    rows = np.flatnonzero(models.ok & (np.bincount(models.window_box, weights=cusp, minlength=len(models.ok)) == 1))
+    one = np.bincount(models.window_box, weights=cusp, minlength=len(models.ok)) == 1
+    of_degree = np.bincount(models.window_box, weights=cusp & (models.degree == request.param),
+                            minlength=len(models.ok)) == 1
+    rows = np.flatnonzero(models.ok & one & of_degree)
     return models, cusp_retractions(paper_geometry, models, rows)
 
 
@@ -100,3 +108,29 @@ def test_the_lifted_path_keeps_the_signature_up_to_a_face(lifted, paper_geometry
         assert left is not None and cr.faces[i, side, way, left], (row, side, way, left)
         done += 1
     assert done >= 6
+
+
+def test_unions_read_as_cusp_windows_hold_one_or_three_roots(fold_paving, paper_geometry):
+    """Property test against independent certified solves: a union of runs with Rolle bound 4 and end signs that
+    differ (a cusp window of ``joined_windows(max_degree=4)``) holds one or three solutions at sampled points,
+    never 0, 2 or 4 (which a wrong degree bound or end sign would allow); and unions of bound 5 are not read as
+    cusp windows."""
+    models = joined_windows(fold_paving.windows.models, max_degree=6)
+    cusp = cusp_windows(models)
+    assert not np.any(cusp & (models.degree > 4))
+    wins = np.flatnonzero(cusp & (models.degree == 4))
+    assert wins.size > 100
+    rng = np.random.default_rng(3)
+    seen = {}
+    for w in rng.choice(wins, 60, replace=False):
+        box = models.boxes[models.window_box[w]]
+        on = models.piece_window == w
+        wa, wb = models.piece_lo[on][0], models.piece_hi[on][-1]  # wa > wb: across phi = pi
+        for _ in range(4):
+            got = _signature(paper_geometry, box[:, 0] + rng.random(3) * (box[:, 1] - box[:, 0]))
+            if got is None:
+                continue
+            inside = [p for p in got[1] if (wa <= p <= wb if wa < wb else (p >= wa or p <= wb))]
+            seen[len(inside)] = seen.get(len(inside), 0) + 1
+    assert seen and set(seen) <= {1, 3}, seen
+    assert sum(seen.values()) >= 100

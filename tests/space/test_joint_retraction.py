@@ -259,6 +259,28 @@ def test_the_fixed_point_on_a_small_tiling():
         assert (rank[c1] == 1 and rank[c2] == 1) if resolved else (rank[c1] == -1 and rank[c2] == -1)
 
 
+def test_the_nodes_of_a_leaf_cover_the_signatures_of_its_points(fold_paving, retraction, paper_geometry):
+    """Property test against independent certified solves: at sampled points of leaves with cusp sides or
+    signature-only nodes (including those read from unions of runs of degree 4 to 6) and of leaves with pair
+    patterns, the signature is one of the leaf's nodes' (a node set that missed it would let a neighbour of that
+    signature retract through the leaf without waiting).  Fails if a union's crossing root or its pairs are
+    dropped from the signature-only nodes, or its lifted sides are added with the wrong aspects."""
+    r, p = retraction, fold_paving.paving
+    rng = np.random.default_rng(17)
+    start = np.searchsorted(r.leaf, np.arange(len(p.lo) + 1))
+    checked = {}
+    for source in ("cusp_side", "signature_only", "pair_pattern"):
+        leaves = np.unique(r.leaf[r.source == SOURCES.index(source)])
+        for a in rng.choice(leaves, min(80, leaves.size), replace=False):
+            sigs = {tuple(s) for s in r.signature[start[a]:start[a + 1]]}
+            for _ in range(2):
+                got = _signature(paper_geometry, p.lo[a] + rng.random(3) * (p.hi[a] - p.lo[a]))
+                if got is not None:
+                    assert got in sigs, (source, a, got, sorted(sigs))
+                    checked[source] = checked.get(source, 0) + 1
+    assert all(checked.get(s, 0) >= 60 for s in ("cusp_side", "signature_only", "pair_pattern")), checked
+
+
 def test_the_summary_reports_the_retraction(fold_paving, retraction):
     from dataclasses import replace
 

@@ -1,9 +1,10 @@
 """Cusp windows retracted along the lifted roots: how a box near a cusp edge of g(S) moves off it.
 
 A window model (:mod:`intervalkin.solve.window_model`) of a joint box R has a *cusp window*
-[w_a, w_b] when f''' has one strict sign there, the end signs of f differ (e0 = sign f(w_a)) and
-they, and the sign of D, hold over the whole box: f(.; r) has one or three roots in it, for every r
-in R^2 (r = rho^2).  With three roots phi_1 < phi_2 < phi_3, the signs of f' at them are -e0, e0,
+[w_a, w_b] when f''' has one strict sign there (or a union of runs of sub-windows has the Rolle bound 4,
+:mod:`intervalkin.solve.window_union`), the end signs of f differ (e0 = sign f(w_a)) and they, and the
+sign of D, hold over the whole box: f(.; r) has one or three roots in it, for every r in R^2 (r = rho^2)
+off g(S).  With three roots phi_1 < phi_2 < phi_3, the signs of f' at them are -e0, e0,
 -e0: the MIDDLE root is the only one with e0 f' > 0.  With one root, it has -e0 f' > 0 and
 g(t) = f(t) / (t - phi) (continued by f'(phi) at t = phi) keeps the sign -e0 over the whole window.
 
@@ -71,8 +72,12 @@ class CuspRetractions:
 
 
 def cusp_windows(models: WindowModels) -> np.ndarray:
-    """(w,) bool: the windows of degree 3 whose end signs differ, with end signs and sign of D proved over the box."""
-    return window_kinds(models)[2]
+    """(w,) bool: the windows of degree 3 or 4 whose end signs differ, with end signs and sign of D proved over the
+    box.  Either holds one or three roots at every point off g(S): an odd number (the ends differ), at most the
+    degree (Rolle; 4 is the bound of a union of runs, :func:`~intervalkin.solve.window_union.joined_windows`
+    with ``max_degree`` 4), so not 5.  That is all the lifted paths below use of the degree."""
+    firm, even = window_kinds(models)[:2]
+    return firm & ~even & ((models.degree == 3) | (models.degree == 4))
 
 
 def cusp_retractions(geometry: Geometry, models: WindowModels, rows: np.ndarray,

@@ -16,9 +16,10 @@ same on every run, U is a firm window of that degree (proofs/lemma-window-model.
 and the det A signs of its roots read as for any window whose roots are bounded by Rolle).
 
 :func:`joined_windows` returns the models with every such union in place of its runs (degree the bound
-above, when it is at most 3); the other windows are unchanged.  The retraction of the open layer
-(:mod:`intervalkin.space.joint_retraction`) reads its pair and cusp windows from it; the certified counts
-at points keep the runs (their inner cut signs decide more points).
+above, when it is at most 3, or a larger ``max_degree``); the other windows are unchanged.  The retraction
+of the open layer (:mod:`intervalkin.space.joint_retraction`) reads its pair and cusp windows from it (and
+unions up to degree 4 and 6 where those leave a leaf without nodes); the certified counts at points keep the
+runs (their inner cut signs decide more points).
 """
 
 from __future__ import annotations
@@ -42,10 +43,12 @@ def joined_degree(degrees: np.ndarray, group: np.ndarray, groups: int) -> np.nda
     return low + total - size * low
 
 
-def joined_windows(models: WindowModels) -> WindowModels:
+def joined_windows(models: WindowModels, max_degree: int = MAX_JOINED_DEGREE) -> WindowModels:
     """The models with each run of sub-windows (linked by inner cuts, end sign 0) joined into one window when its
-    degree bound is at most :data:`MAX_JOINED_DEGREE`, its outer end signs are certified and D has one sign on
-    every run; the windows stay sorted by box, the pieces in circle order."""
+    degree bound is at most ``max_degree``, its outer end signs are certified and D has one sign on every run;
+    the windows stay sorted by box, the pieces in circle order.  The bound holds whatever its size; the pair and
+    cusp models read windows of degree 2 or 3 (the default), the signature-only nodes of the retraction take
+    unions up to 6 (no joint vector has more roots)."""
     w = len(models.degree)
     if w == 0:
         return models
@@ -61,7 +64,7 @@ def joined_windows(models: WindowModels) -> WindowModels:
     np.minimum.at(d_lo, group, models.d_sign.astype(np.int64))
     np.maximum.at(d_hi, group, models.d_sign.astype(np.int64))
     outer = np.stack([ends[first, 0], ends[last, 1]], axis=1)
-    join = (size > 1) & (degree <= MAX_JOINED_DEGREE) & (d_lo == d_hi) & (d_lo != 0) & (outer != 0).all(axis=1)
+    join = (size > 1) & (degree <= max_degree) & (d_lo == d_hi) & (d_lo != 0) & (outer != 0).all(axis=1)
     # a joined group becomes one window, every other window stays itself
     keep = ~join[group] | ~linked  # the first window of a joined group carries the union
     new_id = np.cumsum(keep) - 1

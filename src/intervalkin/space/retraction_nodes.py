@@ -234,44 +234,68 @@ def window_nodes(jp, geometry: Geometry, nodes: Nodes, workers: Workers | None =
                 at = _within_rolle(split, constant, wins, real)
                 nodes.add(win.leaf[rk[at]], base[rk[at]] + int(real.sum()) * PAIR, RET, 3, -1,
                           *_direction_options(keeps[at]), plane=(split, rk[at]))
-    # one cusp window, the others of fixed count: a node for each side (one root, three roots), lifted paths
-    cusp = cusp_windows(models)
-    n_cusp = np.bincount(box, weights=cusp, minlength=n)
-    others = np.bincount(box, weights=~cusp & ~constant, minlength=n) == 0
-    crows = np.flatnonzero(open_rows & (n_cusp == 1) & others & (split.plane == 0))  # lifted paths may cross a plane
-    if crows.size:
-        lifted = cusp_retractions(geometry, models, crows)
-        for side in (0, 1):
-            nodes.add(win.leaf[crows], base[crows] + lifted.adds[:, side], RET, 4, -1, lifted.faces[:, side],
-                      np.zeros(lifted.faces.shape[2:3] + (3,)))  # lifted paths, not segments
+    # one cusp window, the others of fixed count: a node for each side (one root, three roots), lifted paths (not
+    # where a plane cuts the leaf: they may cross it)
+    crows = _cusp_nodes(geometry, models, open_rows & (split.plane == 0), nodes, win.leaf)
     done = np.isin(folds.kind, (CLEAR, FOLD))
     done[rows] = True
     done[fixed] = True
     done[crows] = True
-    _signature_nodes(models, open_rows & ~done, base, nodes, win.leaf)
-    done[open_rows & (np.bincount(box, weights=~window_kinds(models)[0], minlength=n) == 0)] = True
+    # runs of sub-windows whose Rolle bound is 4 with end signs that differ hold one or three roots: cusp windows too
+    done[_cusp_nodes(geometry, joined_windows(win.models, max_degree=4), open_rows & ~done, nodes, win.leaf)] = True
+    done |= _signature_nodes(models, open_rows & ~done, nodes, win.leaf)
+    # the rows left have a window decided only at points (a run of sub-windows whose Rolle bound exceeds 3): the
+    # same runs joined up to degree 6 give them signatures too
+    done |= _signature_nodes(joined_windows(win.models, max_degree=MAX_ROOTS), open_rows & ~done, nodes, win.leaf)
     return np.flatnonzero(~done)
 
 
-def _signature_nodes(models, rows: np.ndarray, base: np.ndarray, nodes: Nodes, leaf_of_row: np.ndarray) -> None:
+def _cusp_nodes(geometry: Geometry, models, rows: np.ndarray, nodes: Nodes, leaf_of_row: np.ndarray) -> np.ndarray:
+    """The nodes of the rows (n,) bool with one cusp window and all their other windows of fixed count (one root
+    each): each side (one root, three roots) with its lifted paths; returns the rows given nodes."""
+    cusp = cusp_windows(models)
+    box, n = models.window_box, len(models.ok)
+    constant = window_kinds(models)[3]
+    n_cusp = np.bincount(box, weights=cusp, minlength=n)
+    others = np.bincount(box, weights=~cusp & ~constant, minlength=n) == 0
+    crows = np.flatnonzero(rows & (n_cusp == 1) & others)
+    if crows.size:
+        base = base_signature(models)
+        lifted = cusp_retractions(geometry, models, crows)
+        for side in (0, 1):
+            nodes.add(leaf_of_row[crows], base[crows] + lifted.adds[:, side], RET, 4, -1, lifted.faces[:, side],
+                      np.zeros(lifted.faces.shape[2:3] + (3,)))  # lifted paths, not segments
+    return crows
+
+
+def _signature_nodes(models, rows: np.ndarray, nodes: Nodes, leaf_of_row: np.ndarray) -> np.ndarray:
     """Rows (n,) bool whose windows are all firm but fit no node above (a cusp window beside pair windows, more
-    pair windows than MAX_PAIR_WINDOWS): one node per signature they allow, with no way out.  Each cusp window adds
-    its one root (aspect by the crossing rule) and maybe a pair, each pair window maybe a pair; so the signatures
-    are base + cusp roots + j PAIR, j = 0..(pair + cusp windows).  Never ranked, but a neighbour of another
-    signature need not wait for them, as it must for a LEFT leaf."""
-    firm, even, cusp, _ = window_kinds(models)
+    pair windows than MAX_PAIR_WINDOWS, a union of degree 4 to 6): one node per signature they allow, with no way
+    out; returns the rows given nodes.  A firm window of degree d holds at most d roots (Rolle); they alternate
+    in the sign of f', and D has one sign on it, so their det A signs alternate too.  Ends that differ: an odd
+    number, the first and the last crossing as the ends say (one root of the aspect of the crossing rule, and
+    pairs); equal ends: pairs of one root of each aspect.  So the signatures are off + the crossing roots
+    + j PAIR, j = 0..sum of (d - odd) // 2 over the windows.  Never ranked, but a neighbour of another signature
+    need not wait for them, as it must for a LEFT leaf."""
+    firm, even, _, _ = window_kinds(models)
     box, n = models.window_box, len(models.ok)
     rows = np.flatnonzero(rows & (np.bincount(box, weights=~firm, minlength=n) == 0))
     if not rows.size:
-        return
+        return np.zeros(n, dtype=bool)
     ends = models.end_signs.astype(np.int64)
-    det_pos = cusp & ((DET_SIGN * models.d_sign.astype(np.int64) * np.where(ends[:, 0] < 0, 1, -1)) > 0)
-    root = np.stack([np.bincount(box, weights=w, minlength=n) for w in (cusp, det_pos, cusp & ~det_pos)],
+    odd = firm & ~even
+    det_pos = odd & ((DET_SIGN * models.d_sign.astype(np.int64) * np.where(ends[:, 0] < 0, 1, -1)) > 0)
+    root = np.stack([np.bincount(box, weights=w, minlength=n) for w in (odd, det_pos, odd & ~det_pos)],
                     axis=1).astype(np.int64)
-    extra = np.bincount(box, weights=even | cusp, minlength=n).astype(np.int64)
+    pairs = np.where(firm, (models.degree.astype(np.int64) - odd) // 2, 0)
+    extra = np.bincount(box, weights=pairs, minlength=n).astype(np.int64)
+    fixed = models.off.astype(np.int64) + root
     for j in range(int(extra[rows].max()) + 1):
-        at = rows[extra[rows] >= j]
-        nodes.add(leaf_of_row[at], base[at] + root[at] + j * PAIR, RET, 5, -1, np.zeros((1, 6), dtype=bool))
+        at = rows[(extra[rows] >= j) & (fixed[rows, 0] + 2 * j <= MAX_ROOTS)]
+        nodes.add(leaf_of_row[at], fixed[at] + j * PAIR, RET, 5, -1, np.zeros((1, 6), dtype=bool))
+    out = np.zeros(n, dtype=bool)
+    out[rows] = True
+    return out
 
 
 def _within_rolle(split, constant: np.ndarray, wins: np.ndarray, real: np.ndarray) -> np.ndarray:
