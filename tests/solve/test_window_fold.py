@@ -204,7 +204,7 @@ def test_direction_signs_hold_exactly_in_blocks_and_agree_with_interval_sums(rng
     grads of very different magnitudes, one infinite end and a NaN; and they match the direction-by-direction
     interval sums except where a sum is within rounding of 0 (rows whose x_1 and x_2 are one float apart make
     such sums).  Fails if a block is skipped or misaligned."""
-    from intervalkin.solve.window_fold import _SIGN_BLOCK, _direction_signs
+    from intervalkin.solve.root_directions import _SIGN_BLOCK, _direction_signs
     from intervalkin.space.retraction_nodes import DIRECTIONS
 
     m = 2 * _SIGN_BLOCK + 37  # three blocks, the last one short

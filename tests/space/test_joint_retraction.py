@@ -81,12 +81,17 @@ def test_ranks_follow_the_rule_across_each_exit_face(fold_paving, retraction):
 
 def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retraction, paper_geometry):
     """Property test against independent certified solves: a point of a resolved node (of a signature no other node
-    of its leaf has) keeps the node's signature on the segment along the exit direction up to the face."""
+    of its leaf has) keeps the node's signature on the segment along the exit direction up to the face: fold
+    pieces, window pieces, pair patterns, and cusp sides that leave along a segment (only pairs dying on the
+    one-root side, only born on the three-root side)."""
     r, p = retraction, fold_paving.paving
     rng = np.random.default_rng(11)
     checked = {name: 0 for name in SOURCES}
-    for source in (1, 2, 3):
-        nodes = np.flatnonzero((r.source == source) & (r.rank > 0))
+    straight = np.zeros(r.leaf.size, dtype=bool)  # nodes that left along a segment (cusp sides may use lifted paths)
+    resolved = np.flatnonzero(r.rank > 0)
+    straight[resolved] = np.abs(r.option_direction[r.exit[resolved]]).sum(axis=1) > 0
+    for source in (1, 2, 3, 4):
+        nodes = np.flatnonzero((r.source == source) & (r.rank > 0) & straight)
         rng.shuffle(nodes)
         for node in nodes[:150]:
             a = r.leaf[node]
@@ -109,6 +114,7 @@ def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retract
                 assert got is None or got == tuple(r.signature[node]), (SOURCES[source], node, y)
             checked[SOURCES[source]] += 1
     assert checked["fold_piece"] >= 10 and checked["window_piece"] >= 2 and checked["pair_pattern"] >= 20, checked
+    assert checked["cusp_side"] >= 10, checked  # straight ways of cusp sides (solve.window_cusp.cusp_direction_signs)
 
 
 def test_fold_pieces_leave_sideways_where_the_sheet_keeps_them(fold_paving, retraction, paper_geometry):

@@ -27,6 +27,11 @@ r_i moves with the sign of d (u_i f_v - v_i f_u) / f_v: one face of axis i where
 otherwise.  The pairs (u, v) tried: the six axis pairs (u = e_a, v = e_l) and one pair per box read at its
 centre (proofs/lemma-joint-retraction.md, "Cusp windows: lifted paths").  Certified: every factor is an
 outward-rounded ball enclosure (:meth:`intervalkin.solve.simple_roots.ReducedBoxes.r_slope`).
+
+Away from the cusp edge a straight segment can keep a side too: :func:`cusp_direction_signs` signs
+sigma D_e f at the window's double roots, sigma the sign of f'' there; where only pairs can die along e the
+one-root side keeps its count, where only pairs can be born the three-root side does ("Cusp windows: straight
+ways" in the same lemma).
 """
 
 from __future__ import annotations
@@ -37,11 +42,13 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval, sign_label
+from intervalkin.core.workers import Workers
+from intervalkin.solve.root_directions import piece_direction_signs
 from intervalkin.solve.simple_roots import ReducedBoxes
-from intervalkin.solve.window_fold import window_kinds
+from intervalkin.solve.window_fold import MIN_PARALLEL_BOXES, STEADY, window_kinds, window_parts
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
-__all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_retractions", "cusp_windows"]
+__all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_retractions", "cusp_windows", "cusp_direction_signs"]
 
 #: Halvings of a cusp window's pieces before the slopes are read.
 HALVINGS = 0
@@ -218,3 +225,55 @@ def _centre_directions(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray,
     np.add.at(u, owner[at], w / np.maximum(np.linalg.norm(w, axis=1, keepdims=True), 1e-300))
     u /= np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-300)
     return u, v
+
+
+def cusp_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndarray, directions: np.ndarray,
+                         workers: Workers | None = None) -> np.ndarray:
+    """(w, c) int8 per cusp window of boxes ``rows`` and direction e (c, 3) in rho: +1 where only pairs can die
+    along e, -1 where only pairs can be born, :data:`~intervalkin.solve.window_fold.STEADY` where no point of
+    the box is a double root of f in the window, 0 otherwise (other windows: 0).
+
+    The window's count changes along a segment only through a double root phi* of f in it (its ends have a
+    proved sign of f).  On a *critical piece* (f and f' both may vanish) where f'' has a proved sign sigma, f
+    has a fold at phi*: near it f's critical point moves smoothly and its value c(t) has c' = D_e f (f' = 0
+    there), so sigma D_e f > 0 lets a pair near phi* only die (two roots just before, none after) and
+    sigma D_e f < 0 only be born.  +1: sigma D_e f > 0 at the double roots of every critical piece that may hold
+    one (:func:`~intervalkin.solve.root_directions.piece_direction_signs` at the roots); then the one-root side
+    keeps its count along e (no pair to die, none born: a pair born beside the single root would make a triple
+    root, where f'' = 0); -1: likewise < 0, and the three-root side keeps its count (a death would need two of
+    its roots to merge; a birth would make five, more than the window's degree).  ``workers``: boxes in parts
+    (each window's signs come from its own box alone)."""
+    rows = np.asarray(rows, dtype=np.int64)
+    directions = np.asarray(directions, dtype=np.float64)
+    w = len(models.degree)
+    out = np.zeros((w, len(directions)), dtype=np.int8)
+    if workers is not None and workers.count > 1 and rows.size >= MIN_PARALLEL_BOXES:
+        for at, signs in window_parts(_cusp_part, geometry, models, rows, workers, directions):
+            out[at] = signs
+        return out
+    cusp = cusp_windows(models) & np.isin(models.window_box, rows)
+    if not cusp.any():
+        return out
+    row = np.full(len(models.ok), -1, dtype=np.int64)
+    row[rows] = np.arange(rows.size)
+    on = np.isin(models.piece_window, np.flatnonzero(cusp))
+    pw, lo, hi = models.piece_window[on], models.piece_lo[on], models.piece_hi[on]
+    data = ReducedBoxes(geometry, models.boxes[rows])
+    owner = row[models.window_box][pw]
+    crit = (sign_label(data.enclosure(owner, lo, hi, 0)) == 0) & (sign_label(data.enclosure(owner, lo, hi, 1)) == 0)
+    pw, lo, hi, owner = pw[crit], lo[crit], hi[crit], owner[crit]
+    sigma = sign_label(data.enclosure(owner, lo, hi, 2))
+    signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions)
+    held = np.flatnonzero(~quiet)
+    held = held[np.argsort(pw[held], kind="stable")]
+    win, start = np.unique(pw[held], return_index=True)
+    if win.size:
+        sg = signs[held] * sigma[held][:, None]  # 0 where f'' has no proved sign: nothing proved
+        low, high = np.minimum.reduceat(sg, start, axis=0), np.maximum.reduceat(sg, start, axis=0)
+        out[win] = np.where((low == high) & (np.abs(low) == 1), low, 0)
+    out[cusp & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
+    return out
+
+
+def _cusp_part(geometry: Geometry, models: WindowModels, directions: np.ndarray) -> np.ndarray:
+    return cusp_direction_signs(geometry, models, np.arange(len(models.ok)), directions)

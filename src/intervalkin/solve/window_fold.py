@@ -43,13 +43,11 @@ import numpy as np
 
 from intervalkin.core.errors import InputError
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.interval import Interval, sign_label
+from intervalkin.core.interval import sign_label
 from intervalkin.core.workers import Workers
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_count import window_signature
-from intervalkin.solve.root_directions import (double_root_signs, integer_combinations, root_direction_signs,
-                                              simple_on_branches)
-from intervalkin.solve.window_split import aligned_r_slopes
+from intervalkin.solve.root_directions import piece_direction_signs
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced",
@@ -288,25 +286,7 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     pw, lo, hi = _critical(data, row[models.window_box], s, models.piece_window[on], models.piece_lo[on],
                            models.piece_hi[on], halvings)
     owner = row[models.window_box][pw]
-    box = models.boxes[rows][owner]
-    aligned = aligned_r_slopes(geometry, models.boxes[rows], owner, lo, hi)
-    grad = [data.r_slope(owner, lo, hi, axis).intersect(aligned[axis])
-            * Interval(2.0 * box[:, axis, 0], 2.0 * box[:, axis, 1]) for axis in range(3)]
-    quiet = np.zeros(pw.size, dtype=bool)  # critical pieces proved to hold no root of f
-    root = np.zeros((pw.size, len(directions)), dtype=np.int8)
-    if at_roots:
-        root, quiet = root_direction_signs(geometry, models.boxes[rows], owner, lo, hi, directions)
-        quiet |= simple_on_branches(geometry, models.boxes[rows], owner, lo, hi)
-        need = np.flatnonzero(~quiet & (root == 0).any(axis=1))
-        double, no_double = double_root_signs(geometry, models.boxes[rows], owner[need], lo[need], hi[need],
-                                              directions)
-        # both signs hold at a double root: opposite ones prove the piece holds none
-        quiet[need] |= no_double | (root[need] * double < 0).any(axis=1)
-        root[need] = np.where(root[need] != 0, root[need], double)
-    sg = _direction_signs(grad, directions)
-    # both hold at any root of the piece: opposite proved signs prove it holds none
-    quiet |= ((sg * root) < 0).any(axis=1)
-    signs = np.where(sg != 0, sg, root)
+    signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions, at_roots)
     free = even & (np.bincount(pw, minlength=w) == 0)
     # one sign per window and direction where all its pieces that may hold a root agree
     held = np.flatnonzero(~quiet)
@@ -321,17 +301,25 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     return out, free
 
 
+def window_parts(fn, geometry: Geometry, models: WindowModels, rows: np.ndarray, workers: Workers,
+                 *args) -> list[tuple[np.ndarray, tuple]]:
+    """``fn(geometry, models.take(part), *args)`` for parts of the boxes ``rows`` on the workers (each window's
+    result comes from its own box alone, so the arrays are the same bit for bit): (the windows of ``models`` each
+    part holds, in the order :meth:`take` keeps them; its result) per part."""
+    rows = np.unique(rows)  # take() wants increasing rows; every window is then in exactly one part
+    parts = [rows[a:b] for a, b in workers.parts(rows.size, least=MIN_PARALLEL_BOXES)]
+    got = workers.run(fn, [(geometry, models.take(part)) + tuple(args) for part in parts])
+    return [(np.flatnonzero(models.window_renumber(part) >= 0), res) for part, res in zip(parts, got)]
+
+
 def _pair_direction_parts(geometry: Geometry, models: WindowModels, rows: np.ndarray, directions: np.ndarray,
                           halvings: int, at_roots: bool, workers: Workers) -> tuple[np.ndarray, np.ndarray]:
     """:func:`pair_direction_signs` with the boxes ``rows`` cut into parts, one call each on their models alone."""
-    rows = np.unique(rows)  # take() wants increasing rows; every window is then in exactly one part
-    parts = [rows[a:b] for a, b in workers.parts(rows.size, least=MIN_PARALLEL_BOXES)]
-    got = workers.run(_pair_part, [(geometry, models.take(part), directions, halvings, at_roots) for part in parts])
     w = len(models.degree)
     out = np.zeros((w, len(directions)), dtype=np.int8)
     free = np.zeros(w, dtype=bool)
-    for part, (signs, part_free) in zip(parts, got):
-        at = np.flatnonzero(models.window_renumber(part) >= 0)  # this part's windows, in the order take() keeps
+    for at, (signs, part_free) in window_parts(_pair_part, geometry, models, rows, workers, directions, halvings,
+                                               at_roots):
         out[at] = signs
         free[at] = part_free
     return out, free
@@ -404,24 +392,3 @@ def extreme_corners(lo: np.ndarray, hi: np.ndarray, rising: np.ndarray,
         low_dir = np.where(free, np.asarray(edge_rising)[:, :1], low_dir)
         high_dir = np.where(free, np.asarray(edge_rising)[:, 1:], high_dir)
     return np.where(low_dir > 0, lo, hi), np.where(high_dir > 0, hi, lo)
-
-
-#: Rows per block in :func:`_direction_signs`: its (rows, directions) temporaries stay in cache (the whole array at
-#: once, about 500 MB each on the paper's paving, made the signs three times slower than the direction loop).
-_SIGN_BLOCK = 2048
-
-
-def _direction_signs(grad: list[Interval], directions: np.ndarray) -> np.ndarray:
-    """(m, c) int8: the proved sign of sum_l e_l grad_l for each direction e (c, 3), 0 where not proved.  Integer
-    directions with entries in -2..2 (the retraction's) go through two matrix products per end
-    (:func:`~intervalkin.solve.root_directions.integer_combinations`); others, direction by direction."""
-    if directions.size and np.array_equal(directions, np.round(directions)) and np.abs(directions).max() <= 2:
-        lo = np.column_stack([g.lo for g in grad])
-        hi = np.column_stack([g.hi for g in grad])
-        e = directions.astype(np.int64)
-        out = np.empty((len(lo), len(e)), dtype=np.int8)
-        for a in range(0, len(lo), _SIGN_BLOCK):  # blocks whose (rows, directions) temporaries stay in cache
-            out[a:a + _SIGN_BLOCK] = sign_label(integer_combinations(lo[a:a + _SIGN_BLOCK], hi[a:a + _SIGN_BLOCK], e))
-        return out
-    return np.column_stack([sign_label(grad[0] * e[0] + grad[1] * e[1] + grad[2] * e[2]) for e in directions]
-                           ).reshape(len(grad[0].lo), len(directions)).astype(np.int8)

@@ -17,7 +17,7 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
 from intervalkin.solve.fold_model import height_slopes
-from intervalkin.solve.window_cusp import cusp_retractions, cusp_windows
+from intervalkin.solve.window_cusp import cusp_direction_signs, cusp_retractions, cusp_windows
 from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, STEADY, base_signature, pair_direction_signs,
                                           pair_windows, window_kinds)
 from intervalkin.solve.window_model import DET_SIGN
@@ -236,13 +236,14 @@ def window_nodes(jp, geometry: Geometry, nodes: Nodes, workers: Workers | None =
                           *_direction_options(keeps[at]), plane=(split, rk[at]))
     # one cusp window, the others of fixed count: a node for each side (one root, three roots), lifted paths (not
     # where a plane cuts the leaf: they may cross it)
-    crows = _cusp_nodes(geometry, models, open_rows & (split.plane == 0), nodes, win.leaf)
+    crows = _cusp_nodes(geometry, models, open_rows & (split.plane == 0), nodes, win.leaf, workers)
     done = np.isin(folds.kind, (CLEAR, FOLD))
     done[rows] = True
     done[fixed] = True
     done[crows] = True
     # runs of sub-windows whose Rolle bound is 4 with end signs that differ hold one or three roots: cusp windows too
-    done[_cusp_nodes(geometry, joined_windows(win.models, max_degree=4), open_rows & ~done, nodes, win.leaf)] = True
+    done[_cusp_nodes(geometry, joined_windows(win.models, max_degree=4), open_rows & ~done, nodes, win.leaf,
+                     workers)] = True
     done |= _signature_nodes(models, open_rows & ~done, nodes, win.leaf)
     # the rows left have a window decided only at points (a run of sub-windows whose Rolle bound exceeds 3): the
     # same runs joined up to degree 6 give them signatures too
@@ -250,9 +251,12 @@ def window_nodes(jp, geometry: Geometry, nodes: Nodes, workers: Workers | None =
     return np.flatnonzero(~done)
 
 
-def _cusp_nodes(geometry: Geometry, models, rows: np.ndarray, nodes: Nodes, leaf_of_row: np.ndarray) -> np.ndarray:
+def _cusp_nodes(geometry: Geometry, models, rows: np.ndarray, nodes: Nodes, leaf_of_row: np.ndarray,
+                workers: Workers | None = None) -> np.ndarray:
     """The nodes of the rows (n,) bool with one cusp window and all their other windows of fixed count (one root
-    each): each side (one root, three roots) with its lifted paths; returns the rows given nodes."""
+    each): each side (one root, three roots) with its lifted paths, and the straight directions along which only
+    pairs die (the one-root side) or are born (the three-root side) at the window's double roots; returns the
+    rows given nodes.  ``workers`` share the straight directions' signs."""
     cusp = cusp_windows(models)
     box, n = models.window_box, len(models.ok)
     constant = window_kinds(models)[3]
@@ -262,9 +266,13 @@ def _cusp_nodes(geometry: Geometry, models, rows: np.ndarray, nodes: Nodes, leaf
     if crows.size:
         base = base_signature(models)
         lifted = cusp_retractions(geometry, models, crows)
-        for side in (0, 1):
-            nodes.add(leaf_of_row[crows], base[crows] + lifted.adds[:, side], RET, 4, -1, lifted.faces[:, side],
-                      np.zeros(lifted.faces.shape[2:3] + (3,)))  # lifted paths, not segments
+        signs = cusp_direction_signs(geometry, models, crows, DIRECTIONS, workers)[lifted.window]
+        for side, keeps in ((0, 1), (1, -1)):
+            straight, direction = _direction_options((signs == keeps) | (signs == STEADY))
+            options = np.concatenate([lifted.faces[:, side], straight], axis=1)
+            directions = np.concatenate([np.zeros(lifted.faces.shape[:1] + lifted.faces.shape[2:3] + (3,)), direction],
+                                        axis=1)  # lifted paths have no direction: they are not segments
+            nodes.add(leaf_of_row[crows], base[crows] + lifted.adds[:, side], RET, 4, -1, options, directions)
     return crows
 
 
