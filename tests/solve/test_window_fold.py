@@ -199,7 +199,8 @@ def test_r_slope_encloses_the_derivative(paper_geometry, windows):
 
 
 def test_direction_signs_hold_exactly_in_blocks_and_agree_with_interval_sums(rng):
-    """The retraction's direction signs (integer directions, two matrix products per end, taken in row blocks):
+    """The retraction's direction signs (root_directions._direction_signs: integer directions, two matrix products
+    per end, taken in row blocks):
     where a sign is proved, the exact rational sum sum_l e_l x_l at sampled points of the boxes has it, for
     grads of very different magnitudes, one infinite end and a NaN; and they match the direction-by-direction
     interval sums except where a sum is within rounding of 0 (rows whose x_1 and x_2 are one float apart make

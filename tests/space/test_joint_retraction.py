@@ -46,7 +46,7 @@ def test_every_leaf_has_a_node_and_sinks_lie_in_counted_cells(fold_paving, retra
     assert np.all(r.rank[r.kind == LEFT] == -1)
     # f has at most 6 roots: a node claiming more would be an empty set posing as a blocker
     assert r.signature[:, 0].max() <= 6
-    assert not r.closed()  # cusp windows are LEFT: no upper bound at this depth
+    assert not r.closed()  # pair patterns and cusp sides without a way: no upper bound at this depth
 
 
 def test_ranks_follow_the_rule_across_each_exit_face(fold_paving, retraction):
