@@ -45,7 +45,7 @@ from intervalkin.core.interval import Interval, sign_label
 from intervalkin.core.workers import Workers
 from intervalkin.solve.root_directions import piece_direction_signs
 from intervalkin.solve.simple_roots import ReducedBoxes
-from intervalkin.solve.window_fold import MIN_PARALLEL_BOXES, STEADY, window_kinds, window_parts
+from intervalkin.solve.window_fold import MIN_PARALLEL_BOXES, STEADY, agreed_signs, window_kinds, window_parts
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_retractions", "cusp_windows", "cusp_direction_signs"]
@@ -248,7 +248,7 @@ def cusp_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     w = len(models.degree)
     out = np.zeros((w, len(directions)), dtype=np.int8)
     if workers is not None and workers.count > 1 and rows.size >= MIN_PARALLEL_BOXES:
-        for at, signs in window_parts(_cusp_part, geometry, models, rows, workers, directions):
+        for at, signs in window_parts(cusp_direction_signs, geometry, models, rows, workers, directions):
             out[at] = signs
         return out
     cusp = cusp_windows(models) & np.isin(models.window_box, rows)
@@ -264,16 +264,6 @@ def cusp_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     pw, lo, hi, owner = pw[crit], lo[crit], hi[crit], owner[crit]
     sigma = sign_label(data.enclosure(owner, lo, hi, 2))
     signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions)
-    held = np.flatnonzero(~quiet)
-    held = held[np.argsort(pw[held], kind="stable")]
-    win, start = np.unique(pw[held], return_index=True)
-    if win.size:
-        sg = signs[held] * sigma[held][:, None]  # 0 where f'' has no proved sign: nothing proved
-        low, high = np.minimum.reduceat(sg, start, axis=0), np.maximum.reduceat(sg, start, axis=0)
-        out[win] = np.where((low == high) & (np.abs(low) == 1), low, 0)
+    out[:] = agreed_signs(pw, signs, sigma, quiet, w)  # sigma 0 (f'' without a proved sign): nothing proved
     out[cusp & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
     return out
-
-
-def _cusp_part(geometry: Geometry, models: WindowModels, directions: np.ndarray) -> np.ndarray:
-    return cusp_direction_signs(geometry, models, np.arange(len(models.ok)), directions)

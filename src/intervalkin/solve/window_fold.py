@@ -52,7 +52,7 @@ from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced",
            "fold_piece", "extreme_corners", "base_signature", "window_kinds", "pair_windows", "pair_slopes",
-           "pair_direction_signs"]
+           "pair_direction_signs", "agreed_signs", "window_parts"]
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
@@ -288,27 +288,35 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     owner = row[models.window_box][pw]
     signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions, at_roots)
     free = even & (np.bincount(pw, minlength=w) == 0)
-    # one sign per window and direction where all its pieces that may hold a root agree
-    held = np.flatnonzero(~quiet)
-    held = held[np.argsort(pw[held], kind="stable")]
-    win, start = np.unique(pw[held], return_index=True)
-    if win.size:
-        sg = signs[held] * s[pw[held]].astype(np.int8)[:, None]
-        low, high = np.minimum.reduceat(sg, start, axis=0), np.maximum.reduceat(sg, start, axis=0)
-        out[win] = np.where(even[win, None] & (low == high) & (np.abs(low) == 1), low, 0)
+    out[:] = agreed_signs(pw, signs, s[pw], quiet, w)
     # no root on any critical piece: u never vanishes on the box, whichever its sign (either pattern keeps)
     out[even & ~free & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
     return out, free
 
 
+def agreed_signs(window: np.ndarray, signs: np.ndarray, factor: np.ndarray, quiet: np.ndarray, w: int) -> np.ndarray:
+    """(w, c) int8: for each of ``w`` windows and each direction, the sign that ``factor`` times ``signs`` (pieces
+    (m, c), of window ``window`` (m,)) has on every piece of the window that is not ``quiet``, where that is
+    +-1 on all of them; 0 elsewhere, and for windows with no such piece."""
+    out = np.zeros((w, signs.shape[1]), dtype=np.int8)
+    held = np.flatnonzero(~quiet)
+    held = held[np.argsort(window[held], kind="stable")]
+    win, start = np.unique(window[held], return_index=True)
+    if win.size:
+        sg = signs[held] * np.asarray(factor, dtype=np.int8)[held][:, None]
+        low, high = np.minimum.reduceat(sg, start, axis=0), np.maximum.reduceat(sg, start, axis=0)
+        out[win] = np.where((low == high) & (np.abs(low) == 1), low, 0)
+    return out
+
+
 def window_parts(fn, geometry: Geometry, models: WindowModels, rows: np.ndarray, workers: Workers,
                  *args) -> list[tuple[np.ndarray, tuple]]:
-    """``fn(geometry, models.take(part), *args)`` for parts of the boxes ``rows`` on the workers (each window's
-    result comes from its own box alone, so the arrays are the same bit for bit): (the windows of ``models`` each
-    part holds, in the order :meth:`take` keeps them; its result) per part."""
+    """``fn(geometry, part_models, all_their_rows, *args)`` for parts of the boxes ``rows`` on the workers (each
+    window's result comes from its own box alone, so the arrays are the same bit for bit): (the windows of
+    ``models`` each part holds, in the order :meth:`take` keeps them; its result) per part."""
     rows = np.unique(rows)  # take() wants increasing rows; every window is then in exactly one part
     parts = [rows[a:b] for a, b in workers.parts(rows.size, least=MIN_PARALLEL_BOXES)]
-    got = workers.run(fn, [(geometry, models.take(part)) + tuple(args) for part in parts])
+    got = workers.run(fn, [(geometry, models.take(part), np.arange(part.size)) + tuple(args) for part in parts])
     return [(np.flatnonzero(models.window_renumber(part) >= 0), res) for part, res in zip(parts, got)]
 
 
@@ -318,16 +326,11 @@ def _pair_direction_parts(geometry: Geometry, models: WindowModels, rows: np.nda
     w = len(models.degree)
     out = np.zeros((w, len(directions)), dtype=np.int8)
     free = np.zeros(w, dtype=bool)
-    for at, (signs, part_free) in window_parts(_pair_part, geometry, models, rows, workers, directions, halvings,
-                                               at_roots):
+    for at, (signs, part_free) in window_parts(pair_direction_signs, geometry, models, rows, workers, directions,
+                                               halvings, at_roots):
         out[at] = signs
         free[at] = part_free
     return out, free
-
-
-def _pair_part(geometry: Geometry, models: WindowModels, directions: np.ndarray, halvings: int,
-               at_roots: bool) -> tuple[np.ndarray, np.ndarray]:
-    return pair_direction_signs(geometry, models, np.arange(len(models.ok)), directions, halvings, at_roots)
 
 
 def _edge_slopes(geometry: Geometry, models: WindowModels, rows: np.ndarray, rising: np.ndarray, window: np.ndarray,
