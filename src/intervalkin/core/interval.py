@@ -42,7 +42,7 @@ import numpy as np
 
 from intervalkin.core.exact import fraction_bounds
 
-__all__ = ['PI_LO', 'PI_HI', 'TRIG_ABS_ERROR', 'TRIG_MAX_ARG', 'round_down', 'round_up', 'Interval', 'certainly_positive', 'certainly_negative', 'sign_label']
+__all__ = ['PI_LO', 'PI_HI', 'TRIG_ABS_ERROR', 'TRIG_MAX_ARG', 'round_down', 'round_up', 'Interval', 'certainly_positive', 'certainly_negative', 'sign_label', 'integer_combinations']
 
 _NEG_INF = -np.inf
 _POS_INF = np.inf
@@ -367,3 +367,17 @@ def certainly_negative(x: Interval) -> np.ndarray:
 def sign_label(x: Interval) -> np.ndarray:
     """int8 array: 1 certainly positive, -1 certainly negative, 0 undecided."""
     return np.where(x.lo > 0, 1, np.where(x.hi < 0, -1, 0)).astype(np.int8)
+
+
+def integer_combinations(lo: np.ndarray, hi: np.ndarray, e: np.ndarray) -> Interval:
+    """(m, c): enclosures of sum_l e_l x_l for x_l in [lo_l, hi_l] (m, k <= 3) and integer rows e (c, k) with
+    entries in -2..2, by two matrix products per end: a float sum of at most six exact products errs by at most
+    5 u times the sum of their magnitudes, and the margin taken is 2**-50 = 8 u times it
+    (proofs/lemma-line-misses-circle.md, Enclosures)."""
+    pos, neg = np.maximum(e, 0).T.astype(np.float64), np.minimum(e, 0).T.astype(np.float64)
+    with np.errstate(invalid="ignore"):
+        c_lo, c_hi = lo @ pos + hi @ neg, hi @ pos + lo @ neg
+        margin = (np.maximum(np.abs(lo), np.abs(hi)) @ np.abs(e).T.astype(np.float64)) * 2.0**-50 + 2.0**-1000
+        c_lo, c_hi = c_lo - margin, c_hi + margin
+    bad = ~(np.isfinite(c_lo) & np.isfinite(c_hi))
+    return Interval(np.where(bad, -np.inf, c_lo), np.where(bad, np.inf, c_hi))

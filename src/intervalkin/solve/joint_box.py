@@ -51,7 +51,7 @@ from intervalkin.core.rows import distinct_rows
 from intervalkin.kinematics.constants import constants
 from intervalkin.kinematics.enclosures import det_a_interval, rho_sq_leg_interval
 
-__all__ = ["Cells", "initial_cells", "live_cells", "clear_boxes", "ROUNDS", "MAX_CELLS"]
+__all__ = ["Cells", "initial_cells", "live_cells", "pose_boxes", "clear_boxes", "ROUNDS", "MAX_CELLS"]
 
 #: Cells of the theta circle and of the phi circle at the start.
 THETA_CELLS = 16
@@ -71,7 +71,7 @@ _ROWS = 1 << 20
 Cells = tuple[np.ndarray, np.ndarray]
 
 
-def _pose_boxes(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray) -> np.ndarray:
+def pose_boxes(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray) -> np.ndarray:
     """Pose boxes (m, 3, 2) [x] x [y] x Phi of cells (m, 4) with leg 1 in rho1 (m, 2): every pose of the cell."""
     k = constants(geometry)
     r1 = Interval(rho1[:, 0], rho1[:, 1])
@@ -168,7 +168,7 @@ def _key_rho_sq(geometry: Geometry, rho1: np.ndarray, cells: np.ndarray) -> tupl
     boxes = np.empty((len(cells), 3, 2))
     bounds = [np.empty(len(cells)) for _ in range(4)]
     for s in range(0, len(cells), _CHUNK):
-        boxes[s:s + _CHUNK] = b = _pose_boxes(geometry, rho1[s:s + _CHUNK], cells[s:s + _CHUNK])
+        boxes[s:s + _CHUNK] = b = pose_boxes(geometry, rho1[s:s + _CHUNK], cells[s:s + _CHUNK])
         for leg, lo, hi in ((1, *bounds[:2]), (2, *bounds[2:])):
             e = rho_sq_leg_interval(geometry, b, leg)
             lo[s:s + _CHUNK], hi[s:s + _CHUNK] = e.lo, e.hi

@@ -11,7 +11,9 @@ zero of D the Taylor form of f cancels; these read f through f |m_2|^2 = s^2 - D
 * :func:`double_root_signs`: at a double root s is also a zero of the phi-derivative of f L, which pins it far
   more tightly (lemma-double-root-s.md);
 * :func:`simple_on_branches`: where V > 0, f L is the product of the branches s -+ D sqrt(V), and pieces where
-  both branches' phi-slopes keep a sign hold no double root (lemma-branch-roots.md).
+  both branches' phi-slopes keep a sign hold no double root (lemma-branch-roots.md);
+* what is still open is read from the singular poses of the full system, which do not degenerate at the zeros of
+  D (:mod:`~intervalkin.solve.singular_directions`, lemma-singular-directions.md).
 
 Everything is vectorised over pieces and directions, in outward-rounded interval and ball arithmetic.
 """
@@ -22,13 +24,14 @@ import numpy as np
 
 from intervalkin.core.ball import Ball, cos_sin_multiple
 from intervalkin.core.geometry import Geometry
-from intervalkin.core.interval import Interval, certainly_positive, sign_label
+from intervalkin.core.interval import Interval, certainly_positive, integer_combinations, sign_label
 from intervalkin.kinematics.reduced_equation import aligned_numerator, denominator
 from intervalkin.solve.simple_roots import ReducedBoxes, trig_basis
+from intervalkin.solve.singular_directions import singular_direction_signs
 from intervalkin.solve.window_split import aligned_r_slopes, aligned_terms
 
 __all__ = ["piece_direction_signs", "root_direction_signs", "double_root_signs", "simple_on_branches", "branch_slopes",
-           "integer_combinations", "S_PARTS"]
+           "S_PARTS"]
 
 
 def piece_direction_signs(geometry: Geometry, boxes: np.ndarray, data: ReducedBoxes, owner: np.ndarray, lo: np.ndarray,
@@ -42,7 +45,9 @@ def piece_direction_signs(geometry: Geometry, boxes: np.ndarray, data: ReducedBo
     only at the roots of f on the pieces (all that a count changing through a double root needs): where the
     whole-piece form gives none, :func:`root_direction_signs`, then :func:`double_root_signs`; pieces where the
     forms disagree (which they could not at a root), or proved free of double roots by :func:`simple_on_branches`,
-    are quiet: they hold no double root, so they need no sign."""
+    are quiet: they hold no double root, so they need no sign.  Last, directions still open take the sign at the
+    singular poses of the piece (:func:`~intervalkin.solve.singular_directions.singular_direction_signs`, where D
+    has a proved sign), and pieces holding none of those are quiet too."""
     box = np.asarray(boxes, dtype=np.float64)[owner]
     aligned = aligned_r_slopes(geometry, boxes, owner, lo, hi)
     grad = [data.r_slope(owner, lo, hi, axis).intersect(aligned[axis])
@@ -60,7 +65,14 @@ def piece_direction_signs(geometry: Geometry, boxes: np.ndarray, data: ReducedBo
     sg = _direction_signs(grad, np.asarray(directions, dtype=np.float64))
     # both hold at any root of the piece: opposite proved signs prove it holds none
     quiet |= ((sg * root) < 0).any(axis=1)
-    return np.where(sg != 0, sg, root), quiet
+    signs = np.where(sg != 0, sg, root)
+    if at_roots:
+        # what the elimination leaves open, the singular poses themselves may give (at the double roots)
+        need = np.flatnonzero(~quiet & (signs == 0).any(axis=1))
+        singular, none = singular_direction_signs(geometry, boxes, owner[need], lo[need], hi[need], directions)
+        quiet[need] |= none | (signs[need] * singular < 0).any(axis=1)
+        signs[need] = np.where(signs[need] != 0, signs[need], singular)
+    return signs, quiet
 
 
 #: Rows per block in :func:`_direction_signs`: its (rows, directions) temporaries stay in cache (the whole array at
@@ -158,20 +170,6 @@ def _direction_terms(box: np.ndarray, slopes: Ball, leg: Interval, d: Interval, 
                                  directions[:, :2])
     d2 = d.sqr()
     return de_s, Interval(d2.lo[:, None], d2.hi[:, None]) * de_v
-
-
-def integer_combinations(lo: np.ndarray, hi: np.ndarray, e: np.ndarray) -> Interval:
-    """(m, c): enclosures of sum_l e_l x_l for x_l in [lo_l, hi_l] (m, k <= 3) and integer rows e (c, k) with
-    entries in -2..2, by two matrix products per end: a float sum of at most six exact products errs by at most
-    5 u times the sum of their magnitudes, and the margin taken is 2**-50 = 8 u times it
-    (proofs/lemma-line-misses-circle.md, Enclosures)."""
-    pos, neg = np.maximum(e, 0).T.astype(np.float64), np.minimum(e, 0).T.astype(np.float64)
-    with np.errstate(invalid="ignore"):
-        c_lo, c_hi = lo @ pos + hi @ neg, hi @ pos + lo @ neg
-        margin = (np.maximum(np.abs(lo), np.abs(hi)) @ np.abs(e).T.astype(np.float64)) * 2.0**-50 + 2.0**-1000
-        c_lo, c_hi = c_lo - margin, c_hi + margin
-    bad = ~(np.isfinite(c_lo) & np.isfinite(c_hi))
-    return Interval(np.where(bad, -np.inf, c_lo), np.where(bad, np.inf, c_hi))
 
 
 def simple_on_branches(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,

@@ -1,0 +1,155 @@
+"""The signs of D_e f at the double roots of f read from the singular poses (solve/singular_directions.py).
+
+- the identity D_e f = -8 D sum_l e_l rho_l w_l at singular poses, in arb at 200 bits against central differences
+  of f in r (both geometries, poses anywhere and beside the zeros of D);
+- ``singular_direction_signs`` on boxes and pieces around singular poses: never says a piece holding one is
+  quiet, and every sign it proves is that of D_e f there (arb); it proves signs the elimination's forms do not;
+- a piece far from every singular pose of its box is quiet, and a sign is never given where D is not signed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from flint import arb, ctx
+
+from intervalkin.solve.root_directions import double_root_signs, root_direction_signs
+from intervalkin.solve.singular_directions import denominator_signs, singular_direction_signs, singular_pose_cells
+from intervalkin.space.retraction_nodes import DIRECTIONS
+from tests.solve.shared import det_zeros_along_y
+from tests.solve.test_window_split import _arb_parts, _fold_points
+
+
+def _legs(geometry, pose):
+    """(u_l = B_l - A_l as (3, 2) floats, the platform offsets) at a float pose (x, y, phi)."""
+    x, y, phi = pose
+    c, s = np.cos(phi), np.sin(phi)
+    u = []
+    for i in range(3):
+        px, py = (float(v) for v in geometry.platform_point(i))
+        ax, ay = (float(v) for v in geometry.base[i])
+        u.append((x + c * px - s * py - ax, y + s * px + c * py - ay))
+    return np.array(u)
+
+
+def _singular_poses(geometry, rng, count):
+    """(x, y, phi) poses with det A = 0 to about an ulp (float bisection along y) and rho inside the limits."""
+    lo, hi = float(max(geometry.rho_min)), float(min(geometry.rho_max))
+    x = rng.uniform(-25, 25, 4000)
+    phi = rng.uniform(-np.pi, np.pi, 4000)
+    line, a, b = det_zeros_along_y(geometry, x, phi, np.linspace(-30, 30, 121))
+    out = []
+    for k in rng.permutation(line.size):
+        pose = np.array([x[line[k]], 0.5 * (a[k] + b[k]), phi[line[k]]])
+        rho = np.hypot(*_legs(geometry, pose).T)
+        if np.all((lo + 0.5 < rho) & (rho < hi - 0.5)):
+            out.append(pose)
+            if len(out) == count:
+                break
+    return out
+
+
+def _df_arb(geometry, rho, phi):
+    """D_e f for the unit axes, (3,) floats: central differences in r of f in arb at 200 bits."""
+    r = rho ** 2
+    grad = []
+    for axis in range(3):
+        step = np.zeros(3)
+        step[axis] = 1e-7
+        up, down = _arb_parts(geometry, r + step, phi)[0], _arb_parts(geometry, r - step, phi)[0]
+        run = arb(float((r + step)[axis])) - arb(float((r - step)[axis]))
+        grad.append(2 * rho[axis] * float(((up - down) / run).mid()))
+    return np.array(grad)
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_the_identity_at_singular_poses(which, paper_geometry, second_geometry, rng):
+    """At singular poses, f and f' vanish at the pose's phi and D_e f = -8 D sum_l e_l rho_l w_l (w_l = u_m x u_n).
+    A factor 4 instead of 8, or w_l taken as u_n x u_m, fails."""
+    geometry = paper_geometry if which == "paper" else second_geometry
+    poses = _singular_poses(geometry, rng, 25)
+    assert len(poses) >= 20
+    with ctx.workprec(200):
+        for pose in poses:
+            u = _legs(geometry, pose)
+            rho = np.hypot(*u.T)
+            w = np.array([u[(l + 1) % 3, 0] * u[(l + 2) % 3, 1] - u[(l + 1) % 3, 1] * u[(l + 2) % 3, 0] for l in range(3)])
+            f, _, _, _, d = _arb_parts(geometry, rho ** 2, pose[2])
+            scale = float(abs(_arb_parts(geometry, rho ** 2 + 1.0, pose[2])[0]).mid())
+            assert abs(float(f.mid())) < 1e-7 * scale
+            predicted = -8.0 * float(d.mid()) * rho * w
+            grad = _df_arb(geometry, rho, pose[2])
+            assert np.allclose(grad, predicted, rtol=1e-5, atol=1e-9 * np.abs(predicted).sum()), (pose, grad, predicted)
+
+
+def _check_signs(geometry, rng, points):
+    """Boxes and pieces around (phi, rho) double roots: never quiet; proved signs are those of D_e f (arb).
+    Returns (signs proved, of which the elimination's forms leave open)."""
+    proved = beyond = 0
+    with ctx.workprec(200):
+        for phi, rho in points:
+            width = 10 ** rng.uniform(-3, -1.5)
+            box = np.stack([rho - rng.uniform(0, width, 3), rho + rng.uniform(0, width, 3)], axis=1)[None]
+            lo, hi = np.array([phi - 10 ** rng.uniform(-5, -3)]), np.array([phi + 10 ** rng.uniform(-5, -3)])
+            one = np.zeros(1, dtype=np.int64)
+            signs, quiet = singular_direction_signs(geometry, box, one, lo, hi, DIRECTIONS)
+            if denominator_signs(geometry, lo, hi)[0] == 0:
+                assert not signs.any() and not quiet[0]
+                continue
+            assert not quiet[0], "a piece holding a singular pose called quiet"
+            old, _ = root_direction_signs(geometry, box, one, lo, hi, DIRECTIONS)
+            double, _ = double_root_signs(geometry, box, one, lo, hi, DIRECTIONS)
+            grad = _df_arb(geometry, rho, phi)
+            scale = np.abs(grad).sum()
+            for c, e in enumerate(DIRECTIONS):
+                value = float(np.dot(e, grad))
+                if signs[0, c] == 0 or abs(value) < 1e-6 * scale:
+                    continue
+                proved += 1
+                beyond += old[0, c] == 0 and double[0, c] == 0
+                assert np.sign(value) == signs[0, c], (phi, rho, e, value, signs[0, c])
+    return proved, beyond
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_signs_hold_at_singular_poses_anywhere(which, paper_geometry, second_geometry, rng):
+    """Around singular poses anywhere in the joint box.  With the sign of D dropped, or the minus, it fails."""
+    geometry = paper_geometry if which == "paper" else second_geometry
+    points = []
+    for pose in _singular_poses(geometry, rng, 25):
+        points.append((pose[2], np.hypot(*_legs(geometry, pose).T)))
+    proved, _ = _check_signs(geometry, rng, points)
+    assert proved >= 200, proved
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_signs_hold_at_the_folds_beside_the_zeros_of_d(which, paper_geometry, second_geometry, rng):
+    """At double roots of f near the zeros of D (float Newton), where the elimination's forms fail most: the signs
+    hold, and some of them are signs that neither root_direction_signs nor double_root_signs proves."""
+    geometry = paper_geometry if which == "paper" else second_geometry
+    folds = [(phi, np.sqrt(r)) for phi, r in _fold_points(geometry, rng, 20)]
+    assert len(folds) >= 10, len(folds)
+    proved, beyond = _check_signs(geometry, rng, folds)
+    assert proved >= 100 and beyond >= 10, (proved, beyond)
+
+
+def test_pieces_away_from_the_singular_poses_are_quiet(paper_geometry, rng):
+    """A box around a joint vector with 6 solutions (far from g(S)) holds no singular pose for any phi: every piece of
+    the circle where D is signed is quiet and gets no sign; the cells cover nothing there."""
+    box = np.array([[[14.96, 15.0], [15.36, 15.4], [11.98, 12.02]]])  # Table 1's joint vector, 6 solutions
+    cuts = np.linspace(-3.14, 3.14, 61)
+    lo, hi = cuts[:-1], cuts[1:]
+    owner = np.zeros(lo.size, dtype=np.int64)
+    signs, quiet = singular_direction_signs(paper_geometry, box, owner, lo, hi, DIRECTIONS)
+    signed = denominator_signs(paper_geometry, lo, hi) != 0
+    assert signed.sum() >= 50
+    assert quiet[signed].all() and not quiet[~signed].any() and not signs.any()
+    cell_of, _ = singular_pose_cells(paper_geometry, box, owner, lo, hi)
+    assert cell_of.size == 0
+
+
+def test_directions_past_two_are_refused(paper_geometry):
+    box = np.array([[[15.0, 15.1], [15.0, 15.1], [15.0, 15.1]]])
+    with pytest.raises(ValueError, match="-2..2"):
+        singular_direction_signs(paper_geometry, box, np.zeros(1, dtype=np.int64), np.array([0.5]), np.array([0.6]),
+                                 np.array([[3, 0, 0]]))
