@@ -49,6 +49,26 @@ def _singular_poses(geometry, rng, count):
     return out
 
 
+def _kernel(geometry, pose):
+    """The kernel vector (k_x, k_y, 1) of A at a float singular pose (the least singular vector, scaled)."""
+    from intervalkin.kinematics.formulas import approx_jacobian
+
+    _, _, vt = np.linalg.svd(approx_jacobian(geometry, pose[None])[0])
+    return vt[-1] / vt[-1][2]
+
+
+def _det_gradient(geometry, pose):
+    """grad det A at a float pose, by central differences of the float det A."""
+    from intervalkin.kinematics.formulas import approx_det_a
+
+    out = np.zeros(3)
+    for axis in range(3):
+        step = np.zeros(3)
+        step[axis] = 1e-6
+        out[axis] = (approx_det_a(geometry, (pose + step)[None])[0] - approx_det_a(geometry, (pose - step)[None])[0]) / 2e-6
+    return out
+
+
 def _df_arb(geometry, rho, phi):
     """D_e f for the unit axes, (3,) floats: central differences in r of f in arb at 200 bits."""
     r = rho ** 2
@@ -64,8 +84,9 @@ def _df_arb(geometry, rho, phi):
 
 @pytest.mark.parametrize("which", ["paper", "second"])
 def test_the_identity_at_singular_poses(which, paper_geometry, second_geometry, rng):
-    """At singular poses, f and f' vanish at the pose's phi and D_e f = -8 D sum_l e_l rho_l w_l (w_l = u_m x u_n).
-    A factor 4 instead of 8, or w_l taken as u_n x u_m, fails."""
+    """At singular poses, f and f' vanish at the pose's phi, D_e f = -8 D sum_l e_l rho_l w_l (w_l = u_m x u_n) and
+    f'' = D grad det A . k (k the kernel of A with k_phi = 1).  A factor 4 instead of 8, w_l taken as u_n x u_m,
+    or f'' without its factor D, fails."""
     geometry = paper_geometry if which == "paper" else second_geometry
     poses = _singular_poses(geometry, rng, 25)
     assert len(poses) >= 20
@@ -80,11 +101,25 @@ def test_the_identity_at_singular_poses(which, paper_geometry, second_geometry, 
             predicted = -8.0 * float(d.mid()) * rho * w
             grad = _df_arb(geometry, rho, pose[2])
             assert np.allclose(grad, predicted, rtol=1e-5, atol=1e-9 * np.abs(predicted).sum()), (pose, grad, predicted)
+            # f'' = D (grad det A . k) with k the kernel of A, k_phi = 1
+            h = 1e-5
+            f0, fp, fm = (_arb_parts(geometry, rho ** 2, pose[2] + t)[0] for t in (0.0, h, -h))
+            second = float(((fp - 2 * f0 + fm) / (arb(h) ** 2)).mid())
+            kernel = _kernel(geometry, pose)
+            expected = float(d.mid()) * float(np.dot(_det_gradient(geometry, pose), kernel))
+            assert abs(second - expected) <= 1e-4 * abs(expected) + 1e-9 * scale, (pose, second, expected)
+
+
+def _f_second(geometry, rho, phi):
+    """f'' at (phi, rho), central differences in phi in arb."""
+    h = 1e-5
+    f0, fp, fm = (_arb_parts(geometry, rho ** 2, phi + t)[0] for t in (0.0, h, -h))
+    return float(((fp - 2 * f0 + fm) / (arb(h) ** 2)).mid())
 
 
 def _check_signs(geometry, rng, points):
-    """Boxes and pieces around (phi, rho) double roots: never quiet; proved signs are those of D_e f (arb).
-    Returns (signs proved, of which the elimination's forms leave open)."""
+    """Boxes and pieces around (phi, rho) double roots: never quiet; proved signs are those of D_e f (arb), and with
+    ``fold`` those of f'' D_e f.  Returns (signs proved, of which the elimination's forms leave open)."""
     proved = beyond = 0
     with ctx.workprec(200):
         for phi, rho in points:
@@ -108,6 +143,15 @@ def _check_signs(geometry, rng, points):
                 proved += 1
                 beyond += old[0, c] == 0 and double[0, c] == 0
                 assert np.sign(value) == signs[0, c], (phi, rho, e, value, signs[0, c])
+            folded, fold_quiet = singular_direction_signs(geometry, box, one, lo, hi, DIRECTIONS, fold=True)
+            assert not fold_quiet[0]
+            second = np.sign(_f_second(geometry, rho, phi))
+            for c, e in enumerate(DIRECTIONS):
+                value = float(np.dot(e, grad))
+                if folded[0, c] == 0 or abs(value) < 1e-6 * scale:
+                    continue
+                proved += 1
+                assert second * np.sign(value) == folded[0, c], (phi, rho, e, value, second, folded[0, c])
     return proved, beyond
 
 

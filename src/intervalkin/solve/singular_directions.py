@@ -31,6 +31,11 @@ the clear-box search (:mod:`intervalkin.solve.joint_box`) started on the piece's
 pose with rho(X) in R lies in one of them).  When no cell is live the piece holds no
 singular pose, hence (with D of one sign) no double root of f.
 
+The same curve gives f'': differentiating F(X(phi; r); r) = G (1, 1, 1) in phi and multiplying by w, G' = det A / D
+along the curve, so at a double root f'' = D^2 G'' = D (grad det A . k), k = (dz/dphi, 1) the kernel of A there.
+The cusp sides' straight ways need sigma D_e f with sigma the sign of f'' (:mod:`~intervalkin.solve.window_cusp`):
+that is -sign(grad det A . k) sign(sum_l e_l rho_l w_l), in which D cancels (``fold=True``).
+
 Each live cell holds some of those poses, so a sign that every cell of a piece proves holds at all of them.
 
 What is certified: both outputs, from outward-rounded intervals (proofs/lemma-singular-directions.md).
@@ -42,11 +47,11 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, Interval, integer_combinations, sign_label
-from intervalkin.kinematics.enclosures import jacobian_interval
-from intervalkin.kinematics.reduced_equation import denominator
+from intervalkin.kinematics.enclosures import det_a_gradient_interval, jacobian_interval
 from intervalkin.solve.joint_box import THETA_CELLS, live_cells, pose_boxes
+from intervalkin.solve.window_split import denominator_enclosure
 
-__all__ = ["singular_direction_signs", "singular_pose_cells", "denominator_signs", "CELL_ROUNDS"]
+__all__ = ["singular_direction_signs", "singular_pose_cells", "curvature_signs", "denominator_signs", "CELL_ROUNDS"]
 
 #: Bisection rounds of the torus cells on a piece's phi range (each halves theta or phi, whichever moves the pose
 #: more).  On the paper's paving, of the pieces the other forms leave open, 22 %, 36 % and 40 % are proved to hold
@@ -83,24 +88,23 @@ def singular_pose_cells(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray
 
 
 def denominator_signs(geometry: Geometry, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """(m,) int8: the proved sign of D(phi) = d_0 + d_1 cos phi + d_2 sin phi over [lo, hi], 0 where not proved."""
-    phi = Interval(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64))
-    d = denominator(geometry)
-    value = phi.cos() * Interval(d.lo[1], d.hi[1]) + phi.sin() * Interval(d.lo[2], d.hi[2]) + Interval(d.lo[0], d.hi[0])
-    return sign_label(value).astype(np.int8)
+    """(m,) int8: the proved sign of D(phi) = d_0 + d_1 cos phi + d_2 sin phi over [lo, hi], 0 where not proved
+    (:func:`~intervalkin.solve.window_split.denominator_enclosure`, which keeps pieces next to a zero of D signed)."""
+    return sign_label(denominator_enclosure(geometry, lo, hi)).astype(np.int8)
 
 
 def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
-                             hi: np.ndarray, directions: np.ndarray,
+                             hi: np.ndarray, directions: np.ndarray, fold: bool = False,
                              rounds: int = CELL_ROUNDS) -> tuple[np.ndarray, np.ndarray]:
     """((m, c) int8, the sign of D_e f at every double root of f in R^2 x [lo, hi], R = boxes[owner], for each
     integer direction e (c, 3) in rho with entries in -2..2, 0 where not proved; (m,) bool, pieces proved to hold
-    no double root of f).
+    no double root of f).  ``fold``: the sign of f'' D_e f instead, with f'' != 0 proved at those double roots.
 
-    Only pieces on which D has a proved sign get either (the identity of the module docstring needs D != 0, and
-    where D vanishes f has double roots that are not singular).  There the sign at the singular poses of each
-    live cell is -sign(D) sign(sum_l e_l rho_l w_l), rho over R and w over the cell's pose box; the piece's sign
-    is the one every cell proves.  A piece with no live cell is quiet."""
+    Only pieces on which D has a proved sign get either (the identities of the module docstring need D != 0, and
+    where D vanishes f has double roots that are not singular).  There, at the singular poses of each live cell,
+    D_e f has the sign -sign(D) sign(sum_l e_l rho_l w_l), rho over R and w over the cell's pose box, and
+    f'' D_e f the sign -sign(grad det A . k) sign(sum_l e_l rho_l w_l), k the kernel of A with k_phi = 1; the
+    piece's sign is the one every cell proves.  A piece with no live cell is quiet."""
     boxes = np.asarray(boxes, dtype=np.float64)
     directions = np.asarray(directions, dtype=np.int64)
     if directions.size and np.abs(directions).max() > 2:
@@ -125,10 +129,31 @@ def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.nd
         terms.append(w * Interval(rho[:, l, 0], rho[:, l, 1]))
     combined = integer_combinations(np.column_stack([x.lo for x in terms]), np.column_stack([x.hi for x in terms]),
                                     directions)
-    per_cell = -sign_label(combined).astype(np.int8)
+    factor = curvature_signs(geometry, poses, A) if fold else d_sign[rows[cell_of]]
+    per_cell = (-sign_label(combined) * factor[:, None]).astype(np.int8)
     # each cell holds some of the piece's singular poses: the piece has a sign where every cell proves the same one
     start = np.flatnonzero(np.r_[True, cell_of[1:] != cell_of[:-1]])
     low, high = np.minimum.reduceat(per_cell, start, axis=0), np.maximum.reduceat(per_cell, start, axis=0)
-    piece = rows[cell_of[start]]
-    signs[piece] = np.where(low == high, low, 0) * d_sign[piece][:, None]
+    signs[rows[cell_of[start]]] = np.where(low == high, low, 0)
     return signs, quiet
+
+
+def curvature_signs(geometry: Geometry, poses: np.ndarray, A: Interval | None = None) -> np.ndarray:
+    """(k,) int8: the proved sign of grad det A . k over each pose box, k the kernel vector of A with k_phi = 1 at its
+    singular poses (0 where not proved), which is sign(D) sign(f'') at a double root of f there.
+
+    k is taken as row_a x row_b of A (a kernel vector wherever those rows are independent and A is singular) divided
+    by its phi entry 4 u_a x u_b; the pair (a, b) is the first of the three whose product is signed."""
+    if A is None:
+        A = jacobian_interval(geometry, poses)
+    grad = det_a_gradient_interval(geometry, poses)
+    out = np.zeros(len(poses), dtype=np.int8)
+    for a, b in ((0, 1), (1, 2), (2, 0)):
+        ra, rb = A[:, a], A[:, b]
+        kx = ra[:, 1] * rb[:, 2] - ra[:, 2] * rb[:, 1]
+        ky = ra[:, 2] * rb[:, 0] - ra[:, 0] * rb[:, 2]
+        kp = ra[:, 0] * rb[:, 1] - ra[:, 1] * rb[:, 0]
+        dot = grad[:, 0] * kx + grad[:, 1] * ky + grad[:, 2] * kp
+        got = sign_label(dot) * sign_label(kp)
+        out = np.where(out != 0, out, got).astype(np.int8)
+    return out

@@ -44,6 +44,7 @@ from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval, sign_label
 from intervalkin.core.workers import Workers
 from intervalkin.solve.root_directions import piece_direction_signs
+from intervalkin.solve.singular_directions import singular_direction_signs
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_fold import MIN_PARALLEL_BOXES, STEADY, agreed_signs, window_kinds, window_parts
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
@@ -241,7 +242,9 @@ def cusp_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     one (:func:`~intervalkin.solve.root_directions.piece_direction_signs` at the roots); then the one-root side
     keeps its count along e (no pair to die, none born: a pair born beside the single root would make a triple
     root, where f'' = 0); -1: likewise < 0, and the three-root side keeps its count (a death would need two of
-    its roots to merge; a birth would make five, more than the window's degree).  ``workers``: boxes in parts
+    its roots to merge; a birth would make five, more than the window's degree).  Where the elimination's forms leave
+    sigma D_e f open, its sign at the singular poses of the piece is read with f'' != 0 proved at each
+    (:func:`~intervalkin.solve.singular_directions.singular_direction_signs` with ``fold``).  ``workers``: boxes in parts
     (each window's signs come from its own box alone)."""
     rows = np.asarray(rows, dtype=np.int64)
     directions = np.asarray(directions, dtype=np.float64)
@@ -264,6 +267,13 @@ def cusp_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     pw, lo, hi, owner = pw[crit], lo[crit], hi[crit], owner[crit]
     sigma = sign_label(data.enclosure(owner, lo, hi, 2))
     signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions)
-    out[:] = agreed_signs(pw, signs, sigma, quiet, w)  # sigma 0 (f'' without a proved sign): nothing proved
+    folded = signs * sigma[:, None]  # sigma 0 (f'' without a proved sign): nothing proved by these forms
+    # where they leave sigma D_e f open, the singular poses give it with f'' != 0 at each double root
+    need = np.flatnonzero(~quiet & (folded == 0).any(axis=1))
+    pose_signs, none = singular_direction_signs(geometry, models.boxes[rows], owner[need], lo[need], hi[need],
+                                                directions, fold=True)
+    quiet[need] |= none | (folded[need] * pose_signs < 0).any(axis=1)
+    folded[need] = np.where(folded[need] != 0, folded[need], pose_signs)
+    out[:] = agreed_signs(pw, folded, np.ones(pw.size, dtype=np.int8), quiet, w)
     out[cusp & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
     return out
