@@ -30,7 +30,7 @@ from intervalkin.solve.simple_roots import ReducedBoxes, trig_basis
 from intervalkin.solve.singular_directions import singular_direction_signs
 from intervalkin.solve.window_split import aligned_r_slopes, aligned_terms
 
-__all__ = ["piece_direction_signs", "root_direction_signs", "double_root_signs", "simple_on_branches", "branch_slopes",
+__all__ = ["piece_direction_signs", "with_singular_signs", "root_direction_signs", "double_root_signs", "simple_on_branches", "branch_slopes",
            "S_PARTS"]
 
 
@@ -45,9 +45,8 @@ def piece_direction_signs(geometry: Geometry, boxes: np.ndarray, data: ReducedBo
     only at the roots of f on the pieces (all that a count changing through a double root needs): where the
     whole-piece form gives none, :func:`root_direction_signs`, then :func:`double_root_signs`; pieces where the
     forms disagree (which they could not at a root), or proved free of double roots by :func:`simple_on_branches`,
-    are quiet: they hold no double root, so they need no sign.  Last, directions still open take the sign at the
-    singular poses of the piece (:func:`~intervalkin.solve.singular_directions.singular_direction_signs`, where D
-    has a proved sign), and pieces holding none of those are quiet too."""
+    are quiet: they hold no double root, so they need no sign.  The callers then fill what is still open on the
+    windows that need it from the singular poses (:func:`with_singular_signs`)."""
     box = np.asarray(boxes, dtype=np.float64)[owner]
     aligned = aligned_r_slopes(geometry, boxes, owner, lo, hi)
     grad = [data.r_slope(owner, lo, hi, axis).intersect(aligned[axis])
@@ -65,14 +64,25 @@ def piece_direction_signs(geometry: Geometry, boxes: np.ndarray, data: ReducedBo
     sg = _direction_signs(grad, np.asarray(directions, dtype=np.float64))
     # both hold at any root of the piece: opposite proved signs prove it holds none
     quiet |= ((sg * root) < 0).any(axis=1)
-    signs = np.where(sg != 0, sg, root)
-    if at_roots:
-        # what the elimination leaves open, the singular poses themselves may give (at the double roots)
-        need = np.flatnonzero(~quiet & (signs == 0).any(axis=1))
-        singular, none = singular_direction_signs(geometry, boxes, owner[need], lo[need], hi[need], directions)
-        quiet[need] |= none | (signs[need] * singular < 0).any(axis=1)
-        signs[need] = np.where(signs[need] != 0, signs[need], singular)
-    return signs, quiet
+    return np.where(sg != 0, sg, root), quiet
+
+
+def with_singular_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                        directions: np.ndarray, signs: np.ndarray, quiet: np.ndarray, pieces: np.ndarray,
+                        fold: bool = False, curvature: np.ndarray | None = None) -> None:
+    """Fill, in place, the open directions of ``pieces`` (indices into the arrays of :func:`piece_direction_signs`)
+    with the signs at the singular poses of the piece
+    (:func:`~intervalkin.solve.singular_directions.singular_direction_signs`; ``fold``: ``signs`` hold the sign of
+    f'' D_e f; ``curvature``, the sign of f'' proved over each piece or 0, is used where it is known), and make
+    quiet the pieces that hold no double root: those with no singular pose, and those where the two readings prove
+    opposite signs (both hold at a double root, so there is none)."""
+    need = pieces[~quiet[pieces] & (signs[pieces] == 0).any(axis=1)]
+    if not need.size:
+        return
+    singular, none = singular_direction_signs(geometry, boxes, owner[need], lo[need], hi[need], directions, fold=fold,
+                                              curvature=None if curvature is None else curvature[need])
+    quiet[need] |= none | (signs[need] * singular < 0).any(axis=1)
+    signs[need] = np.where(signs[need] != 0, signs[need], singular)
 
 
 #: Rows per block in :func:`_direction_signs`: its (rows, directions) temporaries stay in cache (the whole array at

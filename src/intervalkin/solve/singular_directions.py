@@ -59,8 +59,10 @@ __all__ = ["singular_direction_signs", "singular_pose_cells", "curvature_signs",
 CELL_ROUNDS = 8
 #: A piece with more live cells than this after a round stops bisecting them.
 MAX_CELLS = 64
-#: Pieces searched together (THETA_CELLS cells each at the start).
-_BLOCK = 4096
+#: Pieces searched together (THETA_CELLS cells each at the start): large calls keep live_cells' per-round overhead small.
+_BLOCK = 1 << 16
+#: Pieces whose cells' direction signs are taken together (a few thousand cells x 62 directions stay in cache).
+_SIGN_PIECES = 1024
 
 
 def singular_pose_cells(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -95,6 +97,7 @@ def denominator_signs(geometry: Geometry, lo: np.ndarray, hi: np.ndarray) -> np.
 
 def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
                              hi: np.ndarray, directions: np.ndarray, fold: bool = False,
+                             curvature: np.ndarray | None = None,
                              rounds: int = CELL_ROUNDS) -> tuple[np.ndarray, np.ndarray]:
     """((m, c) int8, the sign of D_e f at every double root of f in R^2 x [lo, hi], R = boxes[owner], for each
     integer direction e (c, 3) in rho with entries in -2..2, 0 where not proved; (m,) bool, pieces proved to hold
@@ -104,7 +107,8 @@ def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.nd
     where D vanishes f has double roots that are not singular).  There, at the singular poses of each live cell,
     D_e f has the sign -sign(D) sign(sum_l e_l rho_l w_l), rho over R and w over the cell's pose box, and
     f'' D_e f the sign -sign(grad det A . k) sign(sum_l e_l rho_l w_l), k the kernel of A with k_phi = 1; the
-    piece's sign is the one every cell proves.  A piece with no live cell is quiet."""
+    piece's sign is the one every cell proves.  A piece with no live cell is quiet.  ``curvature`` (m,) int8: the sign
+    of f'' where it is already proved over the piece (0 elsewhere); with ``fold`` it stands for the cells' own there."""
     boxes = np.asarray(boxes, dtype=np.float64)
     directions = np.asarray(directions, dtype=np.int64)
     if directions.size and np.abs(directions).max() > 2:
@@ -127,14 +131,22 @@ def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.nd
         i, j = (l + 1) % 3, (l + 2) % 3
         w = A[:, i, 0] * A[:, j, 1] - A[:, i, 1] * A[:, j, 0]
         terms.append(w * Interval(rho[:, l, 0], rho[:, l, 1]))
-    combined = integer_combinations(np.column_stack([x.lo for x in terms]), np.column_stack([x.hi for x in terms]),
-                                    directions)
-    factor = curvature_signs(geometry, poses, A) if fold else d_sign[rows[cell_of]]
-    per_cell = (-sign_label(combined) * factor[:, None]).astype(np.int8)
-    # each cell holds some of the piece's singular poses: the piece has a sign where every cell proves the same one
+    t_lo, t_hi = np.column_stack([x.lo for x in terms]), np.column_stack([x.hi for x in terms])
+    factor = d_sign[rows[cell_of]]
+    if fold:  # sign(f'') sign(D) at the double roots: from the piece where proved, else from the cells' poses
+        known = np.zeros(m, dtype=np.int8) if curvature is None else np.asarray(curvature, dtype=np.int8)
+        cell_known = known[rows[cell_of]] * factor
+        factor = np.where(cell_known != 0, cell_known, curvature_signs(geometry, poses, A)).astype(np.int8)
     start = np.flatnonzero(np.r_[True, cell_of[1:] != cell_of[:-1]])
-    low, high = np.minimum.reduceat(per_cell, start, axis=0), np.maximum.reduceat(per_cell, start, axis=0)
-    signs[rows[cell_of[start]]] = np.where(low == high, low, 0)
+    bounds = np.r_[start, cell_of.size]
+    for a in range(0, start.size, _SIGN_PIECES):  # runs of whole pieces whose (cells, directions) arrays stay in cache
+        b = min(a + _SIGN_PIECES, start.size)
+        c = slice(bounds[a], bounds[b])
+        per_cell = (-sign_label(integer_combinations(t_lo[c], t_hi[c], directions)) * factor[c][:, None]).astype(np.int8)
+        # each cell holds some of the piece's singular poses: the piece has a sign where every cell proves the same one
+        at = start[a:b] - bounds[a]
+        low, high = np.minimum.reduceat(per_cell, at, axis=0), np.maximum.reduceat(per_cell, at, axis=0)
+        signs[rows[cell_of[start[a:b]]]] = np.where(low == high, low, 0)
     return signs, quiet
 
 

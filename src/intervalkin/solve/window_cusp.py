@@ -43,8 +43,7 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import Interval, sign_label
 from intervalkin.core.workers import Workers
-from intervalkin.solve.root_directions import piece_direction_signs
-from intervalkin.solve.singular_directions import singular_direction_signs
+from intervalkin.solve.root_directions import piece_direction_signs, with_singular_signs
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_fold import MIN_PARALLEL_BOXES, STEADY, agreed_signs, window_kinds, window_parts
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
@@ -267,13 +266,10 @@ def cusp_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     pw, lo, hi, owner = pw[crit], lo[crit], hi[crit], owner[crit]
     sigma = sign_label(data.enclosure(owner, lo, hi, 2))
     signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions)
-    folded = signs * sigma[:, None]  # sigma 0 (f'' without a proved sign): nothing proved by these forms
-    # where they leave sigma D_e f open, the singular poses give it with f'' != 0 at each double root
-    need = np.flatnonzero(~quiet & (folded == 0).any(axis=1))
-    pose_signs, none = singular_direction_signs(geometry, models.boxes[rows], owner[need], lo[need], hi[need],
-                                                directions, fold=True)
-    quiet[need] |= none | (folded[need] * pose_signs < 0).any(axis=1)
-    folded[need] = np.where(folded[need] != 0, folded[need], pose_signs)
+    folded = (signs * sigma[:, None]).astype(np.int8)  # sigma 0 (f'' without a proved sign): nothing proved
+    # what those forms leave open, the singular poses give: sigma D_e f with f'' != 0 at each double root
+    with_singular_signs(geometry, models.boxes[rows], owner, lo, hi, directions, folded, quiet, np.arange(pw.size),
+                        fold=True, curvature=sigma.astype(np.int8))
     out[:] = agreed_signs(pw, folded, np.ones(pw.size, dtype=np.int8), quiet, w)
     out[cusp & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
     return out

@@ -47,7 +47,7 @@ from intervalkin.core.interval import sign_label
 from intervalkin.core.workers import Workers
 from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_count import window_signature
-from intervalkin.solve.root_directions import piece_direction_signs
+from intervalkin.solve.root_directions import piece_direction_signs, with_singular_signs
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced",
@@ -265,7 +265,8 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     With ``at_roots`` a critical piece also says nothing where no point of it is a double root of f (u vanishes
     only at one: :mod:`~intervalkin.solve.root_directions`, the two branches of f near a zero of D, and s pinned
     at the double roots), and where the root bound leaves a direction open, the sign at the double roots alone
-    fills it (:func:`~intervalkin.solve.root_directions.double_root_signs`).
+    fills it (:func:`~intervalkin.solve.root_directions.double_root_signs`); what is still open is read at the
+    singular poses of the piece (:func:`~intervalkin.solve.root_directions.with_singular_signs`).
 
     ``workers``: boxes are cut into parts computed at once (each window's signs come from its own box alone, so
     the arrays are the same bit for bit)."""
@@ -289,6 +290,12 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions, at_roots)
     free = even & (np.bincount(pw, minlength=w) == 0)
     out[:] = agreed_signs(pw, signs, s[pw], quiet, w)
+    if at_roots:
+        # the singular poses fill what the elimination's forms leave open (windows whose status no point changes aside)
+        steady = (out == STEADY).all(axis=1)
+        with_singular_signs(geometry, models.boxes[rows], owner, lo, hi, directions, signs, quiet,
+                            np.flatnonzero(~steady[pw]))
+        out[:] = agreed_signs(pw, signs, s[pw], quiet, w)
     # no root on any critical piece: u never vanishes on the box, whichever its sign (either pattern keeps)
     out[even & ~free & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
     return out, free
