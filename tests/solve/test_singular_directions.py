@@ -65,7 +65,8 @@ def _det_gradient(geometry, pose):
     for axis in range(3):
         step = np.zeros(3)
         step[axis] = 1e-6
-        out[axis] = (approx_det_a(geometry, (pose + step)[None])[0] - approx_det_a(geometry, (pose - step)[None])[0]) / 2e-6
+        up, down = approx_det_a(geometry, (pose + step)[None])[0], approx_det_a(geometry, (pose - step)[None])[0]
+        out[axis] = (up - down) / 2e-6
     return out
 
 
@@ -94,7 +95,8 @@ def test_the_identity_at_singular_poses(which, paper_geometry, second_geometry, 
         for pose in poses:
             u = _legs(geometry, pose)
             rho = np.hypot(*u.T)
-            w = np.array([u[(l + 1) % 3, 0] * u[(l + 2) % 3, 1] - u[(l + 1) % 3, 1] * u[(l + 2) % 3, 0] for l in range(3)])
+            w = np.array([u[(l + 1) % 3, 0] * u[(l + 2) % 3, 1] - u[(l + 1) % 3, 1] * u[(l + 2) % 3, 0]
+                          for l in range(3)])
             f, _, _, _, d = _arb_parts(geometry, rho ** 2, pose[2])
             scale = float(abs(_arb_parts(geometry, rho ** 2 + 1.0, pose[2])[0]).mid())
             assert abs(float(f.mid())) < 1e-7 * scale

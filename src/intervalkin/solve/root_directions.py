@@ -30,8 +30,8 @@ from intervalkin.solve.simple_roots import ReducedBoxes, trig_basis
 from intervalkin.solve.singular_directions import singular_direction_signs
 from intervalkin.solve.window_split import aligned_r_slopes, aligned_terms
 
-__all__ = ["piece_direction_signs", "with_singular_signs", "root_direction_signs", "double_root_signs", "simple_on_branches", "branch_slopes",
-           "S_PARTS"]
+__all__ = ["piece_direction_signs", "with_singular_signs", "root_direction_signs", "double_root_signs",
+           "simple_on_branches", "branch_slopes", "S_PARTS"]
 
 
 def piece_direction_signs(geometry: Geometry, boxes: np.ndarray, data: ReducedBoxes, owner: np.ndarray, lo: np.ndarray,

@@ -59,7 +59,8 @@ __all__ = ["singular_direction_signs", "singular_pose_cells", "curvature_signs",
 CELL_ROUNDS = 8
 #: A piece with more live cells than this after a round stops bisecting them.
 MAX_CELLS = 64
-#: Pieces searched together (THETA_CELLS cells each at the start): large calls keep live_cells' per-round overhead small.
+#: Pieces searched together (THETA_CELLS cells each at the start): large calls keep the per-round overhead of
+#: live_cells small.
 _BLOCK = 1 << 16
 #: Pieces whose cells' direction signs are taken together (a few thousand cells x 62 directions stay in cache).
 _SIGN_PIECES = 1024
@@ -142,7 +143,8 @@ def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.nd
     for a in range(0, start.size, _SIGN_PIECES):  # runs of whole pieces whose (cells, directions) arrays stay in cache
         b = min(a + _SIGN_PIECES, start.size)
         c = slice(bounds[a], bounds[b])
-        per_cell = (-sign_label(integer_combinations(t_lo[c], t_hi[c], directions)) * factor[c][:, None]).astype(np.int8)
+        combined = integer_combinations(t_lo[c], t_hi[c], directions)
+        per_cell = (-sign_label(combined) * factor[c][:, None]).astype(np.int8)
         # each cell holds some of the piece's singular poses: the piece has a sign where every cell proves the same one
         at = start[a:b] - bounds[a]
         low, high = np.minimum.reduceat(per_cell, at, axis=0), np.maximum.reduceat(per_cell, at, axis=0)

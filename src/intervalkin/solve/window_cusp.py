@@ -241,9 +241,10 @@ def cusp_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     one (:func:`~intervalkin.solve.root_directions.piece_direction_signs` at the roots); then the one-root side
     keeps its count along e (no pair to die, none born: a pair born beside the single root would make a triple
     root, where f'' = 0); -1: likewise < 0, and the three-root side keeps its count (a death would need two of
-    its roots to merge; a birth would make five, more than the window's degree).  Where the elimination's forms leave
-    sigma D_e f open, its sign at the singular poses of the piece is read with f'' != 0 proved at each
-    (:func:`~intervalkin.solve.singular_directions.singular_direction_signs` with ``fold``).  ``workers``: boxes in parts
+    its roots to merge; a birth would make five, more than the window's degree).  Where the elimination's forms
+    leave sigma D_e f open, its sign at the singular poses of the piece is read with f'' != 0 proved at each
+    (:func:`~intervalkin.solve.singular_directions.singular_direction_signs` with ``fold``).  ``workers``: boxes in
+    parts
     (each window's signs come from its own box alone)."""
     rows = np.asarray(rows, dtype=np.int64)
     directions = np.asarray(directions, dtype=np.float64)
