@@ -289,11 +289,9 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     owner = row[models.window_box][pw]
     signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions, at_roots)
     free = even & (np.bincount(pw, minlength=w) == 0)
-    out[:] = agreed_signs(pw, signs, s[pw], quiet, w)
-    if at_roots:
-        # the singular poses fill what the elimination's forms leave open (quiet pieces need nothing)
+    if at_roots:  # the singular poses fill what the elimination's forms leave open (quiet pieces need nothing)
         with_singular_signs(geometry, models.boxes[rows], owner, lo, hi, directions, signs, quiet, np.arange(pw.size))
-        out[:] = agreed_signs(pw, signs, s[pw], quiet, w)
+    out[:] = agreed_signs(pw, signs, s[pw], quiet, w)
     # no root on any critical piece: u never vanishes on the box, whichever its sign (either pattern keeps)
     out[even & ~free & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
     return out, free
