@@ -17,7 +17,7 @@ from intervalkin.solve.root_directions import double_root_signs, root_direction_
 from intervalkin.solve.singular_directions import denominator_signs, singular_direction_signs, singular_pose_cells
 from intervalkin.space.retraction_nodes import DIRECTIONS
 from tests.solve.shared import det_zeros_along_y
-from tests.solve.test_window_split import _arb_parts, _fold_points
+from tests.solve.test_window_split import _arb_parts, _fold_points, signs_agree
 
 
 def _legs(geometry, pose):
@@ -137,23 +137,13 @@ def _check_signs(geometry, rng, points):
             old, _ = root_direction_signs(geometry, box, one, lo, hi, DIRECTIONS)
             double, _ = double_root_signs(geometry, box, one, lo, hi, DIRECTIONS)
             grad = _df_arb(geometry, rho, phi)
-            scale = np.abs(grad).sum()
-            for c, e in enumerate(DIRECTIONS):
-                value = float(np.dot(e, grad))
-                if signs[0, c] == 0 or abs(value) < 1e-6 * scale:
-                    continue
-                proved += 1
-                beyond += old[0, c] == 0 and double[0, c] == 0
-                assert np.sign(value) == signs[0, c], (phi, rho, e, value, signs[0, c])
+            got, new = signs_agree(signs[0], grad, (old[0] == 0) & (double[0] == 0), (phi, rho))
             folded, fold_quiet = singular_direction_signs(geometry, box, one, lo, hi, DIRECTIONS, fold=True)
             assert not fold_quiet[0]
-            second = np.sign(_f_second(geometry, rho, phi))
-            for c, e in enumerate(DIRECTIONS):
-                value = float(np.dot(e, grad))
-                if folded[0, c] == 0 or abs(value) < 1e-6 * scale:
-                    continue
-                proved += 1
-                assert second * np.sign(value) == folded[0, c], (phi, rho, e, value, second, folded[0, c])
+            # f'' D_e f has the sign of e . (sign(f'') grad)
+            got_fold, _ = signs_agree(folded[0], np.sign(_f_second(geometry, rho, phi)) * grad, folded[0] == 0,
+                                      (phi, rho, "fold"))
+            proved, beyond = proved + got + got_fold, beyond + new
     return proved, beyond
 
 
