@@ -244,8 +244,7 @@ def cusp_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     its roots to merge; a birth would make five, more than the window's degree).  Where the elimination's forms
     leave sigma D_e f open, its sign at the singular poses of the piece is read with f'' != 0 proved at each
     (:func:`~intervalkin.solve.singular_directions.singular_direction_signs` with ``fold``).  ``workers``: boxes in
-    parts
-    (each window's signs come from its own box alone)."""
+    parts (each window's signs come from its own box alone)."""
     rows = np.asarray(rows, dtype=np.int64)
     directions = np.asarray(directions, dtype=np.float64)
     w = len(models.degree)
