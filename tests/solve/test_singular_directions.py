@@ -4,7 +4,9 @@
   of f in r (both geometries, poses anywhere and beside the zeros of D);
 - ``singular_direction_signs`` on boxes and pieces around singular poses: never says a piece holding one is
   quiet, and every sign it proves is that of D_e f there (arb); it proves signs the elimination's forms do not;
-- a piece far from every singular pose of its box is quiet, and a sign is never given where D is not signed.
+- a piece far from every singular pose of its box is quiet, and a sign is never given where D is not signed,
+  unless asked (``gap``) with the sign of f'' at the double roots: then the signs read without D (``fold_signs``:
+  left null vector, kernel and second derivative of rho^2 at the pose) hold there too, beside the zeros of D.
 """
 
 from __future__ import annotations
@@ -14,7 +16,10 @@ import pytest
 from flint import arb, ctx
 
 from intervalkin.solve.root_directions import double_root_signs, root_direction_signs
-from intervalkin.solve.singular_directions import denominator_signs, singular_direction_signs, singular_pose_cells
+from intervalkin.kinematics.enclosures import jacobian_interval
+from intervalkin.solve.singular_directions import (denominator_signs, fold_signs, singular_direction_signs,
+                                                   singular_pose_cells)
+from intervalkin.solve.window_split import d_zeros
 from intervalkin.space.retraction_nodes import DIRECTIONS
 from tests.solve.shared import det_zeros_along_y
 from tests.solve.test_window_split import _arb_parts, _fold_points, signs_agree
@@ -167,6 +172,62 @@ def test_signs_hold_at_the_folds_beside_the_zeros_of_d(which, paper_geometry, se
     assert len(folds) >= 10, len(folds)
     proved, beyond = _check_signs(geometry, rng, folds)
     assert proved >= 100 and beyond >= 10, (proved, beyond)
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_fold_signs_are_those_of_f2_times_the_slope_at_singular_poses(which, paper_geometry, second_geometry, rng):
+    """At float singular poses (point boxes), the signs read without D, -sign(y . E) sign(y . H[kappa, kappa]), are
+    those of f'' D_e f (arb central differences), and nearly all of them are proved.  With the kappa_phi^2 term of
+    the second derivative dropped, or its minus, it fails."""
+    geometry = paper_geometry if which == "paper" else second_geometry
+    poses = _singular_poses(geometry, rng, 20)
+    proved = 0
+    with ctx.workprec(200):
+        for pose in poses:
+            rho = np.hypot(*_legs(geometry, pose).T)
+            point = np.stack([pose, pose], axis=-1)[None]
+            signs = fold_signs(geometry, point, jacobian_interval(geometry, point),
+                               np.stack([rho, rho], axis=-1)[None], DIRECTIONS)[0]
+            grad = np.sign(_f_second(geometry, rho, pose[2])) * _df_arb(geometry, rho, pose[2])
+            got, _ = signs_agree(signs, grad, signs == 0, pose)
+            proved += got
+    assert proved >= 0.9 * len(poses) * len(DIRECTIONS), proved
+
+
+def _gap_piece(geometry, phi):
+    """A piece from the fold's phi across the nearest zero of D (D not signed on it)."""
+    zero = d_zeros(geometry)[np.argmin(np.abs(d_zeros(geometry) - phi))]
+    return np.array([min(phi, zero) - 1e-4]), np.array([max(phi, zero) + 1e-4])
+
+
+@pytest.mark.parametrize("which", ["paper", "second"])
+def test_signs_without_d_hold_on_pieces_across_the_zeros_of_d(which, paper_geometry, second_geometry, rng):
+    """Folds beside the zeros of D (float Newton), on pieces from the fold across the zero: D is not signed there, so
+    nothing is proved without ``gap``; with it and the sign of f'' at the double roots, the signs are those of D_e f
+    (arb), with ``fold`` those of f'' D_e f, the pieces holding a singular pose are never quiet, and signs are
+    proved.  With the curvature's sign flipped, it fails."""
+    geometry = paper_geometry if which == "paper" else second_geometry
+    folds = [(phi, np.sqrt(r)) for phi, r in _fold_points(geometry, rng, 14)]
+    assert len(folds) >= 8, len(folds)
+    proved = 0
+    with ctx.workprec(200):
+        for phi, rho in folds:
+            lo, hi = _gap_piece(geometry, phi)
+            assert denominator_signs(geometry, lo, hi)[0] == 0
+            box = np.stack([rho - rng.uniform(0, 1e-3, 3), rho + rng.uniform(0, 1e-3, 3)], axis=1)[None]
+            one = np.zeros(1, dtype=np.int64)
+            plain, _ = singular_direction_signs(geometry, box, one, lo, hi, DIRECTIONS)
+            assert not plain.any()
+            curvature = np.array([np.sign(_f_second(geometry, rho, phi))], dtype=np.int8)
+            grad = _df_arb(geometry, rho, phi)
+            signs, quiet = singular_direction_signs(geometry, box, one, lo, hi, DIRECTIONS, curvature=curvature,
+                                                    gap=True)
+            assert not quiet[0], "a piece holding a singular pose called quiet"
+            got, _ = signs_agree(signs[0], grad, signs[0] == 0, (phi, rho))
+            folded, _ = singular_direction_signs(geometry, box, one, lo, hi, DIRECTIONS, fold=True, gap=True)
+            got_fold, _ = signs_agree(folded[0], curvature[0] * grad, folded[0] == 0, (phi, rho, "fold"))
+            proved += got + got_fold
+    assert proved >= 200, proved
 
 
 def test_pieces_away_from_the_singular_poses_are_quiet(paper_geometry, rng):

@@ -317,14 +317,16 @@ def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_ge
     it proves a direction the signs over whole pieces did not, or calls a window STEADY, the number of solutions in
     the window (an independent certified solve) stays the same from a point of the box along e up to its boundary:
     along e where the window is empty and its sign is +1 or it holds two roots and its sign is -1, along -e in the
-    other cases, either way where STEADY.  Signs over whole pieces are never changed, only added to."""
+    other cases, either way where STEADY; for a half of a window cut at phi_D, as long as the walk keeps its side of
+    the plane s(phi_D; r) = 0, as the nodes do.  Signs over whole pieces are never changed, only added to."""
     from intervalkin.solve.window_fold import STEADY, pair_direction_signs, pair_windows
     from intervalkin.solve.window_plane import split_at_zeros_of_d
     from intervalkin.solve.window_union import joined_windows
     from intervalkin.space.retraction_nodes import DIRECTIONS
 
     win = fold_paving.windows
-    models = split_at_zeros_of_d(paper_geometry, joined_windows(win.models)).models
+    split = split_at_zeros_of_d(paper_geometry, joined_windows(win.models))
+    models = split.models
     # a sample of the boxes with a pair window beside a zero of D, where the signs at the roots tell most
     apart = np.min([np.maximum(np.maximum(models.piece_lo - z, z - models.piece_hi), 0)
                     for z in d_zeros(paper_geometry)], axis=0)  # each piece's distance to the zeros of D
@@ -354,8 +356,16 @@ def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_ge
         e = way * DIRECTIONS[c].astype(float)
         reach = min(np.min(np.where(e > 0, (box[:, 1] - x) / np.where(e > 0, e, 1), np.inf)),
                     np.min(np.where(e < 0, (box[:, 0] - x) / np.where(e < 0, e, -1), np.inf)))
+        # a half of a window cut at phi_D speaks for its box's points on one side of the plane s(phi_D; r) = 0 (its
+        # nodes only move along directions that keep their side): the walk stops where it would cross the plane
+        cut = split.plane[models.window_box[w]]
+        phi_d = d_zeros(paper_geometry)[cut - 1] if cut else None
+        side = mpmath.sign(_s_mp(paper_geometry, x, phi_d)) if cut else 0
         for t in (0.2, 0.4, 0.6, 0.8, 1.0):
-            got = _window_count(paper_geometry, np.clip(x + t * reach * e, box[:, 0], box[:, 1]), *pieces)
+            y = np.clip(x + t * reach * e, box[:, 0], box[:, 1])
+            if cut and mpmath.sign(_s_mp(paper_geometry, y, phi_d)) != side:
+                break
+            got = _window_count(paper_geometry, y, *pieces)
             assert got is None or got == status, (w, DIRECTIONS[c], way, t, status, got)
         checked += 1
         steady += bool(new[w, c] == STEADY)

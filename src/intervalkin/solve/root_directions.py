@@ -69,18 +69,19 @@ def piece_direction_signs(geometry: Geometry, boxes: np.ndarray, data: ReducedBo
 
 def with_singular_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
                         directions: np.ndarray, signs: np.ndarray, quiet: np.ndarray, pieces: np.ndarray,
-                        fold: bool = False, curvature: np.ndarray | None = None) -> None:
+                        fold: bool = False, curvature: np.ndarray | None = None, gap: bool = False) -> None:
     """Fill, in place, the open directions of ``pieces`` (indices into the arrays of :func:`piece_direction_signs`)
     with the signs at the singular poses of the piece
     (:func:`~intervalkin.solve.singular_directions.singular_direction_signs`; ``fold``: ``signs`` hold the sign of
-    f'' D_e f; ``curvature``, the sign of f'' proved over each piece or 0, is used where it is known), and make
+    f'' D_e f; ``curvature``, the sign of f'' at each piece's double roots or 0, is used where it is known; ``gap``:
+    also the pieces where D has no sign, read without D), and make
     quiet the pieces that hold no double root: those with no singular pose, and those where the two readings prove
     opposite signs (both hold at a double root, so there is none)."""
     need = pieces[~quiet[pieces] & (signs[pieces] == 0).any(axis=1)]
     if not need.size:
         return
     singular, none = singular_direction_signs(geometry, boxes, owner[need], lo[need], hi[need], directions, fold=fold,
-                                              curvature=None if curvature is None else curvature[need])
+                                              curvature=None if curvature is None else curvature[need], gap=gap)
     quiet[need] |= none | (signs[need] * singular < 0).any(axis=1)
     signs[need] = np.where(signs[need] != 0, signs[need], singular)
 

@@ -38,7 +38,19 @@ that is -sign(grad det A . k) sign(sum_l e_l rho_l w_l), in which D cancels (``f
 
 Each live cell holds some of those poses, so a sign that every cell of a piece proves holds at all of them.
 
-What is certified: both outputs, from outward-rounded intervals (proofs/lemma-singular-directions.md).
+Without D
+---------
+Whether the pair of roots meeting at a double root dies or is born along e is a property of the pose: at a singular
+pose where A has rank 2, with left null vector y and kernel vector kappa, the direct kinematics has two solutions
+nearby on the side where y . (r - r*) has the sign of y . H[kappa, kappa], H[kappa, kappa]_l the second derivative of
+rho_l^2 along kappa, and none on the other.  So the pair only dies along e where y . E and y . H have opposite signs
+(E = 2 rho e), which is the sign of f'' D_e f where D != 0: -sign(y . E) sign(y . H), with no D at all
+(:func:`fold_signs`).  It serves the pieces where D has no sign (beside its zeros) and the cells where w is too small
+to sign: next to a zero of D the singular poses have their three legs nearly parallel, where every u_a x u_b, so w,
+vanishes, and y is then taken as the product of the other pairs of A's columns.
+
+What is certified: both outputs, from outward-rounded intervals (proofs/lemma-singular-directions.md, statements 4 to
+6).
 """
 
 from __future__ import annotations
@@ -47,11 +59,13 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.interval import PI_HI, Interval, integer_combinations, sign_label
+from intervalkin.kinematics.constants import constants
 from intervalkin.kinematics.enclosures import det_a_gradient_interval, jacobian_interval
 from intervalkin.solve.joint_box import THETA_CELLS, live_cells, pose_boxes
 from intervalkin.solve.window_split import denominator_enclosure
 
-__all__ = ["singular_direction_signs", "singular_pose_cells", "curvature_signs", "denominator_signs", "CELL_ROUNDS"]
+__all__ = ["singular_direction_signs", "singular_pose_cells", "curvature_signs", "denominator_signs", "fold_signs",
+           "CELL_ROUNDS"]
 
 #: Bisection rounds of the torus cells on a piece's phi range (each halves theta or phi, whichever moves the pose
 #: more).  On the paper's paving, of the pieces the other forms leave open, 22 %, 36 % and 40 % are proved to hold
@@ -98,7 +112,7 @@ def denominator_signs(geometry: Geometry, lo: np.ndarray, hi: np.ndarray) -> np.
 
 def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
                              hi: np.ndarray, directions: np.ndarray, fold: bool = False,
-                             curvature: np.ndarray | None = None,
+                             curvature: np.ndarray | None = None, gap: bool = False,
                              rounds: int = CELL_ROUNDS) -> tuple[np.ndarray, np.ndarray]:
     """((m, c) int8, the sign of D_e f at every double root of f in R^2 x [lo, hi], R = boxes[owner], for each
     integer direction e (c, 3) in rho with entries in -2..2, 0 where not proved; (m,) bool, pieces proved to hold
@@ -109,7 +123,14 @@ def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.nd
     D_e f has the sign -sign(D) sign(sum_l e_l rho_l w_l), rho over R and w over the cell's pose box, and
     f'' D_e f the sign -sign(grad det A . k) sign(sum_l e_l rho_l w_l), k the kernel of A with k_phi = 1; the
     piece's sign is the one every cell proves.  A piece with no live cell is quiet.  ``curvature`` (m,) int8: the sign
-    of f'' where it is already proved over the piece (0 elsewhere); with ``fold`` it stands for the cells' own there."""
+    of f'' at the piece's double roots where the caller knows it (0 elsewhere); with ``fold`` it stands for the cells'
+    own there.
+
+    What those leave open in a cell is read without D (:func:`fold_signs`, module docstring "Without D"): with
+    ``fold`` the sign of f'' D_e f itself, otherwise that sign times ``curvature``.  ``gap``: every piece is searched,
+    also those where D has no sign; the double roots of f at a zero phi_D of D (on the plane s(phi_D; r) = 0, where
+    two poses share the orientation phi_D) are then not covered, and a quiet piece holds none but those: the caller
+    must keep its paths off that plane (the retraction's nodes of boxes cut at phi_D do)."""
     boxes = np.asarray(boxes, dtype=np.float64)
     directions = np.asarray(directions, dtype=np.int64)
     if directions.size and np.abs(directions).max() > 2:
@@ -118,7 +139,7 @@ def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.nd
     signs = np.zeros((m, len(directions)), dtype=np.int8)
     quiet = np.zeros(m, dtype=bool)
     d_sign = denominator_signs(geometry, lo, hi)
-    rows = np.flatnonzero(d_sign != 0)
+    rows = np.arange(m) if gap else np.flatnonzero(d_sign != 0)
     if not rows.size:
         return signs, quiet
     cell_of, poses = singular_pose_cells(geometry, boxes, owner[rows], lo[rows], hi[rows], rounds)
@@ -134,8 +155,10 @@ def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.nd
         terms.append(w * Interval(rho[:, l, 0], rho[:, l, 1]))
     t_lo, t_hi = np.column_stack([x.lo for x in terms]), np.column_stack([x.hi for x in terms])
     factor = d_sign[rows[cell_of]]
+    known = np.zeros(m, dtype=np.int8) if curvature is None else np.asarray(curvature, dtype=np.int8)
+    # what the signs without D are multiplied by: 1 for f'' D_e f, else the sign of f'' at the piece's double roots
+    to_out = np.ones(cell_of.size, dtype=np.int8) if fold else known[rows[cell_of]]
     if fold:  # sign(f'') sign(D) at the double roots: from the piece where proved, else from the cells' poses
-        known = np.zeros(m, dtype=np.int8) if curvature is None else np.asarray(curvature, dtype=np.int8)
         cell_known = known[rows[cell_of]] * factor
         factor = np.where(cell_known != 0, cell_known, curvature_signs(geometry, poses, A)).astype(np.int8)
     start = np.flatnonzero(np.r_[True, cell_of[1:] != cell_of[:-1]])
@@ -145,11 +168,77 @@ def singular_direction_signs(geometry: Geometry, boxes: np.ndarray, owner: np.nd
         c = slice(bounds[a], bounds[b])
         combined = integer_combinations(t_lo[c], t_hi[c], directions)
         per_cell = (-sign_label(combined) * factor[c][:, None]).astype(np.int8)
+        # what w leaves open (D not signed, or w near 0 where the legs are nearly parallel): the signs without D
+        open_ = np.flatnonzero((per_cell == 0).any(axis=1) & (to_out[c] != 0))
+        if open_.size:
+            cells = np.arange(bounds[a], bounds[b])[open_]
+            own = fold_signs(geometry, poses[cells], A[cells], rho[cells], directions,
+                             along=sign_label(combined[open_])) * to_out[cells][:, None]
+            per_cell[open_] = np.where(per_cell[open_] != 0, per_cell[open_], own)
         # each cell holds some of the piece's singular poses: the piece has a sign where every cell proves the same one
         at = start[a:b] - bounds[a]
         low, high = np.minimum.reduceat(per_cell, at, axis=0), np.maximum.reduceat(per_cell, at, axis=0)
         signs[rows[cell_of[start[a:b]]]] = np.where(low == high, low, 0)
     return signs, quiet
+
+
+def _cross3(a: list[Interval], b: list[Interval]) -> list[Interval]:
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def fold_signs(geometry: Geometry, poses: np.ndarray, A: Interval, rho: np.ndarray,
+               directions: np.ndarray, along: np.ndarray | None = None) -> np.ndarray:
+    """(k, c) int8: at every singular pose of each pose box (k, 3, 2), with its joint vector in rho (k, 3, 2), the
+    proved sign of f'' D_e f for each integer direction e (c, 3) in rho: +1 where moving along e only lets the pair of
+    roots meeting there die, -1 only be born, 0 not proved.  Read from the pose alone, without D (module docstring,
+    "Without D"): -sign(y . E) sign(y . H[kappa, kappa]), y a left null vector of A, kappa a kernel vector,
+    E = 2 rho e and H[kappa, kappa]_l the second derivative of rho_l^2 along kappa.  ``along`` (k, c): the proved
+    signs of y . E for y = 4 w (the product of A's first two columns), when the caller has them.
+
+    y is tried as the product of A's first two columns (4 w), then, for the cells with a direction still open (w
+    vanishes where the legs are parallel), as the product of the other two pairs; kappa as the product of each two
+    rows."""
+    k = constants(geometry)
+    poses = np.asarray(poses, dtype=np.float64)
+    phi = Interval(poses[:, 2, 0], poses[:, 2, 1])
+    rows = [[A[:, l, j] for j in range(3)] for l in range(3)]
+    cols = [[A[:, l, j] for l in range(3)] for j in range(3)]
+    half_u = [(rows[l][0] * 0.5, rows[l][1] * 0.5) for l in range(3)]  # u_l: row l of A is 2 (u_lx, u_ly, .)
+    zero = Interval.point(np.zeros(len(poses)))
+    plat = [(zero, zero)]  # B_1 is the pose's point: no platform offset
+    for i in (1, 2):
+        a = phi + k.alpha_iv[i]
+        plat.append((k.radius_iv[i] * a.cos(), k.radius_iv[i] * a.sin()))
+    # H[kappa, kappa]_l = 2 |d u_l / d kappa|^2 - 2 kappa_phi^2 u_l . r_l, for kappa the product of each two rows
+    hessians = []
+    for c, d in ((0, 1), (1, 2), (2, 0)):
+        kx, ky, kp = _cross3(rows[c], rows[d])
+        kp2 = kp.sqr()
+        h = []
+        for l in range(3):
+            px, py = plat[l]
+            vx, vy = kx - kp * py, ky + kp * px
+            h.append((vx.sqr() + vy.sqr() - kp2 * (half_u[l][0] * px + half_u[l][1] * py)) * 2.0)
+        hessians.append(h)
+    out = np.zeros((len(poses), len(directions)), dtype=np.int8)
+    todo = np.arange(len(poses))
+    for first, (a, b) in enumerate(((0, 1), (0, 2), (1, 2))):
+        if not todo.size:
+            break
+        y = _cross3([v[todo] for v in cols[a]], [v[todo] for v in cols[b]])
+        curve = np.zeros(todo.size, dtype=np.int8)
+        for h in hessians:
+            dot = y[0] * h[0][todo] + y[1] * h[1][todo] + y[2] * h[2][todo]
+            curve = np.where(curve != 0, curve, sign_label(dot)).astype(np.int8)
+        if along is not None and first == 0:
+            signs = along[todo]
+        else:
+            t = [y[l] * Interval(rho[todo, l, 0], rho[todo, l, 1]) for l in range(3)]
+            signs = sign_label(integer_combinations(np.column_stack([v.lo for v in t]),
+                                                    np.column_stack([v.hi for v in t]), directions))
+        out[todo] = np.where(out[todo] != 0, out[todo], -signs * curve[:, None])
+        todo = todo[(out[todo] == 0).any(axis=1)]
+    return out
 
 
 def curvature_signs(geometry: Geometry, poses: np.ndarray, A: Interval | None = None) -> np.ndarray:

@@ -265,11 +265,10 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     With ``at_roots`` a critical piece also says nothing where no point of it is a double root of f (u vanishes
     only at one: :mod:`~intervalkin.solve.root_directions`, the two branches of f near a zero of D, and s pinned
     at the double roots), and where the root bound leaves a direction open, the sign at the double roots alone
-    fills it (:func:`~intervalkin.solve.root_directions.double_root_signs`); what is still open is read at the
-    singular poses of the piece (:func:`~intervalkin.solve.root_directions.with_singular_signs`).
+    fills it (:func:`~intervalkin.solve.root_directions.double_root_signs`); the singular poses read what is still
+    open (:func:`~.root_directions.with_singular_signs`, gap pieces too: a double root is the only one, s f'' > 0).
 
-    ``workers``: boxes are cut into parts computed at once (each window's signs come from its own box alone, so
-    the arrays are the same bit for bit)."""
+    ``workers``: boxes are cut into parts computed at once (each window's signs come from its own box alone)."""
     w = len(models.degree)
     rows = np.asarray(rows, dtype=np.int64)
     directions = np.asarray(directions, dtype=np.float64)
@@ -289,8 +288,9 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     owner = row[models.window_box][pw]
     signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions, at_roots)
     free = even & (np.bincount(pw, minlength=w) == 0)
-    if at_roots:  # the singular poses fill what the elimination's forms leave open (quiet pieces need nothing)
-        with_singular_signs(geometry, models.boxes[rows], owner, lo, hi, directions, signs, quiet, np.arange(pw.size))
+    if at_roots:  # what the elimination's forms leave open, from the singular poses (quiet pieces need nothing)
+        with_singular_signs(geometry, models.boxes[rows], owner, lo, hi, directions, signs, quiet, np.arange(pw.size),
+                            curvature=s[pw].astype(np.int8), gap=True)
     out[:] = agreed_signs(pw, signs, s[pw], quiet, w)
     # no root on any critical piece: u never vanishes on the box, whichever its sign (either pattern keeps)
     out[even & ~free & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
