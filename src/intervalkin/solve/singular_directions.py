@@ -195,9 +195,8 @@ def fold_signs(geometry: Geometry, poses: np.ndarray, A: Interval, rho: np.ndarr
     E = 2 rho e and H[kappa, kappa]_l the second derivative of rho_l^2 along kappa.  ``along`` (k, c): the proved
     signs of y . E for y = 4 w (the product of A's first two columns), when the caller has them.
 
-    y is tried as the product of A's first two columns (4 w), then, for the cells with a direction still open (w
-    vanishes where the legs are parallel), as the product of the other two pairs; kappa as the product of each two
-    rows."""
+    y is, per cell, the product of two of A's columns with the sharpest enclosure (4 w, the first two, vanishes where
+    the legs are parallel); kappa each product of two rows in turn, until y . H is signed."""
     k = constants(geometry)
     poses = np.asarray(poses, dtype=np.float64)
     phi = Interval(poses[:, 2, 0], poses[:, 2, 1])
@@ -220,24 +219,28 @@ def fold_signs(geometry: Geometry, poses: np.ndarray, A: Interval, rho: np.ndarr
             vx, vy = kx - kp * py, ky + kp * px
             h.append((vx.sqr() + vy.sqr() - kp2 * (half_u[l][0] * px + half_u[l][1] * py)) * 2.0)
         hessians.append(h)
+    # y: per cell the product of two of A's columns whose enclosure is the sharpest (the first, 4 w, vanishes where
+    # the legs are parallel); any nonzero one is a left null vector at the cell's singular poses
+    ys = [_cross3(cols[a], cols[b]) for a, b in ((0, 1), (0, 2), (1, 2))]
+    sharp = np.stack([sum(np.abs(v.mid()) for v in y) / (sum(v.width() for v in y) + 1e-300) for y in ys], axis=1)
+    pick = np.argmax(sharp, axis=1)
     out = np.zeros((len(poses), len(directions)), dtype=np.int8)
-    todo = np.arange(len(poses))
-    for first, (a, b) in enumerate(((0, 1), (0, 2), (1, 2))):
-        if not todo.size:
-            break
-        y = _cross3([v[todo] for v in cols[a]], [v[todo] for v in cols[b]])
-        curve = np.zeros(todo.size, dtype=np.int8)
+    for choice, y in enumerate(ys):
+        at = np.flatnonzero(pick == choice)
+        if not at.size:
+            continue
+        yc = [v[at] for v in y]
+        curve = np.zeros(at.size, dtype=np.int8)
         for h in hessians:
-            dot = y[0] * h[0][todo] + y[1] * h[1][todo] + y[2] * h[2][todo]
+            dot = yc[0] * h[0][at] + yc[1] * h[1][at] + yc[2] * h[2][at]
             curve = np.where(curve != 0, curve, sign_label(dot)).astype(np.int8)
-        if along is not None and first == 0:
-            signs = along[todo]
+        if along is not None and choice == 0:
+            signs = along[at]
         else:
-            t = [y[l] * Interval(rho[todo, l, 0], rho[todo, l, 1]) for l in range(3)]
+            t = [yc[l] * Interval(rho[at, l, 0], rho[at, l, 1]) for l in range(3)]
             signs = sign_label(integer_combinations(np.column_stack([v.lo for v in t]),
                                                     np.column_stack([v.hi for v in t]), directions))
-        out[todo] = np.where(out[todo] != 0, out[todo], -signs * curve[:, None])
-        todo = todo[(out[todo] == 0).any(axis=1)]
+        out[at] = -signs * curve[:, None]
     return out
 
 
