@@ -255,10 +255,7 @@ def curvature_signs(geometry: Geometry, poses: np.ndarray, A: Interval | None = 
     grad = det_a_gradient_interval(geometry, poses)
     out = np.zeros(len(poses), dtype=np.int8)
     for a, b in ((0, 1), (1, 2), (2, 0)):
-        ra, rb = A[:, a], A[:, b]
-        kx = ra[:, 1] * rb[:, 2] - ra[:, 2] * rb[:, 1]
-        ky = ra[:, 2] * rb[:, 0] - ra[:, 0] * rb[:, 2]
-        kp = ra[:, 0] * rb[:, 1] - ra[:, 1] * rb[:, 0]
+        kx, ky, kp = _cross3([A[:, a, j] for j in range(3)], [A[:, b, j] for j in range(3)])
         dot = grad[:, 0] * kx + grad[:, 1] * ky + grad[:, 2] * kp
         got = sign_label(dot) * sign_label(kp)
         out = np.where(out != 0, out, got).astype(np.int8)
