@@ -197,16 +197,29 @@ class ReducedBoxes:
         extra = (spread + second + 2.0**-40 * np.abs(centre)) * (1.0 + 2.0**-40) + 2.0**-1000
         return Ball(mid, t.rad[..., 0] + extra)
 
-    def r_slope(self, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray, axis: int, deriv: int = 0) -> Interval:
+    def r_slope(self, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray, axis: int, deriv: int = 0,
+                mean_value: bool = False) -> Interval:
         """Enclosure of d^(1 + deriv) f / d r_axis d phi^deriv over (box owner, piece [lo, hi]), r_axis = rho_axis^2.
 
         d c_h / d r_axis is affine in r: its value at r_c (a row of the Taylor data) plus
         sum_i (d^2 c_h / d r_axis d r_i) d_i with |d_i| <= h_i; natural form in phi (the basis
-        differentiated ``deriv`` times).
+        differentiated ``deriv`` times).  With ``mean_value``, intersected with the mean-value form in phi (the
+        value at the piece's midpoint plus the next phi-derivative over the piece times the offset): the natural
+        form multiplies the basis' width by the large coefficients of f, which mostly cancel.
         """
+        piece = Ball.from_interval(Interval(lo, hi))
+        natural = self._r_slope_ball(owner, piece, axis, deriv).to_interval()
+        if not mean_value:
+            return natural
+        at_mid = self._r_slope_ball(owner, Ball.point(piece.mid), axis, deriv)
+        rate = self._r_slope_ball(owner, piece, axis, deriv + 1)
+        return natural.intersect((at_mid + rate * Ball(np.zeros_like(piece.mid), piece.rad)).to_interval())
+
+    def _r_slope_ball(self, owner: np.ndarray, phi: Ball, axis: int, deriv: int) -> Ball:
+        """:meth:`r_slope`'s natural form over the balls ``phi``, as balls."""
         taylor = self.taylor[owner]
         half = self.half[owner]
-        w = trig_basis(Ball.from_interval(Interval(lo, hi)), deriv)
+        w = trig_basis(phi, deriv)
         t = w.dot_rows(taylor)  # (m, 4)
         q = w.matmul(self.quad_t)  # (m, 6)
         quad = [e for e in MONOMIALS if len(e) == 2]
@@ -215,7 +228,7 @@ class ReducedBoxes:
             k = quad.index((min(axis, i), max(axis, i)))
             factor = 2.0 if i == axis else 1.0  # d^2 (r_a^2) / d r_a^2 = 2
             spread += factor * (np.abs(q.mid[:, k]) + q.rad[:, k]) * half[:, i]
-        return Ball(t.mid[:, 1 + axis], t.rad[:, 1 + axis] + spread * (1.0 + 2.0**-40) + 2.0**-1000).to_interval()
+        return Ball(t.mid[:, 1 + axis], t.rad[:, 1 + axis] + spread * (1.0 + 2.0**-40) + 2.0**-1000)
 
 
 def _stack(parts: list[Ball], axis: int = -1) -> Ball:

@@ -123,8 +123,9 @@ def cusp_retractions(geometry: Geometry, models: WindowModels, rows: np.ndarray,
     data = ReducedBoxes(geometry, models.boxes[rows])
     f = sign_label(data.enclosure(owner, lo, hi, 0))
     f1 = sign_label(data.enclosure(owner, lo, hi, 1)) * e0[owner]
-    f_r = [data.r_slope(owner, lo, hi, axis) for axis in range(3)]
-    f_phi_r = [data.r_slope(owner, lo, hi, axis, deriv=1) for axis in range(3)]
+    # mean-value forms in phi: the natural form multiplies the basis' width by f's large, mostly cancelling coefficients
+    f_r = [data.r_slope(owner, lo, hi, axis, mean_value=True) for axis in range(3)]
+    f_phi_r = [data.r_slope(owner, lo, hi, axis, deriv=1, mean_value=True) for axis in range(3)]
     # where the followed root can be: the middle root (e0 f' > 0) for three roots, the single root (-e0 f' > 0)
     at_root = {1: (f == 0) & (f1 >= 0), 0: (f == 0) & (f1 <= 0)}
     # new roots can only appear where f may vanish; g(t) involves f' between the root and t: the span of those pieces
