@@ -82,15 +82,15 @@ def test_ranks_follow_the_rule_across_each_exit_face(fold_paving, retraction):
 def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retraction, paper_geometry):
     """Property test against independent certified solves: a point of a resolved node (of a signature no other node
     of its leaf has) keeps the node's signature on the segment along the exit direction up to the face: fold
-    pieces, window pieces, pair patterns, and cusp sides that leave along a segment (only pairs dying on the
-    one-root side, only born on the three-root side)."""
+    pieces, window pieces, pair patterns, cusp sides that leave along a segment (only pairs dying on the
+    one-root side, only born on the three-root side), and cusp patterns (both kinds of window kept at once)."""
     r, p = retraction, fold_paving.paving
     rng = np.random.default_rng(11)
     checked = {name: 0 for name in SOURCES}
     straight = np.zeros(r.leaf.size, dtype=bool)  # nodes that left along a segment (cusp sides may use lifted paths)
     resolved = np.flatnonzero(r.rank > 0)
     straight[resolved] = np.abs(r.option_direction[r.exit[resolved]]).sum(axis=1) > 0
-    for source in (1, 2, 3, 4):
+    for source in (1, 2, 3, 4, SOURCES.index("cusp_pattern")):
         nodes = np.flatnonzero((r.source == source) & (r.rank > 0) & straight)
         rng.shuffle(nodes)
         for node in nodes[:150]:
@@ -115,6 +115,7 @@ def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retract
             checked[SOURCES[source]] += 1
     assert checked["fold_piece"] >= 10 and checked["window_piece"] >= 2 and checked["pair_pattern"] >= 20, checked
     assert checked["cusp_side"] >= 10, checked  # straight ways of cusp sides (solve.window_cusp.cusp_direction_signs)
+    assert checked["cusp_pattern"] >= 10, checked  # a cusp side and pair patterns kept by one segment
 
 
 def test_fold_pieces_leave_sideways_where_the_sheet_keeps_them(fold_paving, retraction, paper_geometry):
@@ -267,15 +268,16 @@ def test_the_fixed_point_on_a_small_tiling():
 
 def test_the_nodes_of_a_leaf_cover_the_signatures_of_its_points(fold_paving, retraction, paper_geometry):
     """Property test against independent certified solves: at sampled points of leaves with cusp sides or
-    signature-only nodes (including those read from unions of runs of degree 4 to 6) and of leaves with pair
-    patterns, the signature is one of the leaf's nodes' (a node set that missed it would let a neighbour of that
-    signature retract through the leaf without waiting).  Fails if a union's crossing root or its pairs are
+    signature-only nodes (including those read from unions of runs of degree 4 to 6), of leaves with pair
+    patterns and of leaves with a cusp window beside pair windows (cusp patterns), the signature is one of the
+    leaf's nodes' (a node set that missed it would let a neighbour of that signature retract through the leaf
+    without waiting).  Fails if a union's crossing root or its pairs are
     dropped from the signature-only nodes, or its lifted sides are added with the wrong aspects."""
     r, p = retraction, fold_paving.paving
     rng = np.random.default_rng(17)
     start = np.searchsorted(r.leaf, np.arange(len(p.lo) + 1))
     checked = {}
-    for source in ("cusp_side", "signature_only", "pair_pattern"):
+    for source in ("cusp_side", "signature_only", "pair_pattern", "cusp_pattern"):
         leaves = np.unique(r.leaf[r.source == SOURCES.index(source)])
         for a in rng.choice(leaves, min(80, leaves.size), replace=False):
             sigs = {tuple(s) for s in r.signature[start[a]:start[a + 1]]}
@@ -284,7 +286,7 @@ def test_the_nodes_of_a_leaf_cover_the_signatures_of_its_points(fold_paving, ret
                 if got is not None:
                     assert got in sigs, (source, a, got, sorted(sigs))
                     checked[source] = checked.get(source, 0) + 1
-    assert all(checked.get(s, 0) >= 60 for s in ("cusp_side", "signature_only", "pair_pattern")), checked
+    assert all(checked.get(s, 0) >= 60 for s in ("cusp_side", "signature_only", "pair_pattern", "cusp_pattern")), checked
 
 
 def test_the_summary_reports_the_retraction(fold_paving, retraction):

@@ -146,7 +146,8 @@ _WHY = {"no_model": "no model", "cusp_window": "cusp window", "window_at_points"
 
 #: Short names of the kinds of nodes (space.joint_retraction.SOURCES).
 _NODES = {"clear": "clear leaves", "fold_piece": "fold pieces", "window_piece": "window pieces",
-          "pair_pattern": "pair-window patterns", "cusp_side": "cusp sides", "no_piece_model": "leaves without pieces"}
+          "pair_pattern": "pair-window patterns", "cusp_side": "cusp sides", "signature_only": "signature-only leaves",
+          "no_piece_model": "leaves without pieces", "cusp_pattern": "cusp sides beside pair windows"}
 
 
 def _retraction_line(block: dict | None) -> str:

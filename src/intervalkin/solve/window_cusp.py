@@ -48,7 +48,7 @@ from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_fold import MIN_PARALLEL_BOXES, STEADY, agreed_signs, window_kinds, window_parts
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
-__all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_retractions", "cusp_windows", "cusp_direction_signs"]
+__all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_adds", "cusp_retractions", "cusp_windows", "cusp_direction_signs"]
 
 #: Halvings of a cusp window's pieces before the slopes are read.
 HALVINGS = 0
@@ -87,6 +87,20 @@ def cusp_windows(models: WindowModels) -> np.ndarray:
     return firm & ~even & ((models.degree == 3) | (models.degree == 4))
 
 
+def cusp_adds(models: WindowModels, window: np.ndarray) -> np.ndarray:
+    """(m, 2, 3) int64: the (count, n_wa1, n_wa2) that each cusp window adds on its one-root side (0) and its
+    three-root side (1).  The det A sign of a root is DET_SIGN sign(D) sign(f'); the outer roots have f' of sign
+    -e0, the middle one e0 (module docstring)."""
+    window = np.asarray(window, dtype=np.int64)
+    m = window.size
+    e0 = models.end_signs[window, 0].astype(np.int64)
+    outer_wa1 = (DET_SIGN * models.d_sign[window].astype(np.int64) * -e0) > 0
+    adds = np.zeros((m, 2, 3), dtype=np.int64)
+    adds[:, 0] = np.stack([np.ones(m, dtype=np.int64), outer_wa1, ~outer_wa1], axis=1)
+    adds[:, 1] = np.stack([np.full(m, 3), 2 * outer_wa1 + ~outer_wa1, 2 * ~outer_wa1 + outer_wa1], axis=1)
+    return adds
+
+
 def cusp_retractions(geometry: Geometry, models: WindowModels, rows: np.ndarray,
                      halvings: int = HALVINGS) -> CuspRetractions:
     """The lifted retractions of boxes ``rows``, each with exactly one cusp window (module docstring).  The
@@ -99,12 +113,7 @@ def cusp_retractions(geometry: Geometry, models: WindowModels, rows: np.ndarray,
     if window.size != m or not np.array_equal(models.window_box[window], rows):
         raise ValueError("cusp_retractions: each row needs exactly one cusp window")
     e0 = models.end_signs[window, 0].astype(np.int64)
-    d = models.d_sign[window].astype(np.int64)
-    # the det A sign of a root is DET_SIGN sign(D) sign(f'); outer roots have f' of sign -e0, the middle one e0
-    outer_wa1 = (DET_SIGN * d * -e0) > 0
-    adds = np.zeros((m, 2, 3), dtype=np.int64)
-    adds[:, 0] = np.stack([np.ones(m, dtype=np.int64), outer_wa1, ~outer_wa1], axis=1)
-    adds[:, 1] = np.stack([np.full(m, 3), 2 * outer_wa1 + ~outer_wa1, 2 * ~outer_wa1 + outer_wa1], axis=1)
+    adds = cusp_adds(models, window)
     k = len(AXIS_PAIRS) + 1
     faces = np.zeros((m, 2, k, 6), dtype=bool)
     drive = np.zeros((m, 2, k), dtype=np.int8)

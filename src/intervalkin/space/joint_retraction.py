@@ -13,6 +13,8 @@ part of U is covered by NODES, sets on which the signature is known at every poi
 * a leaf whose D-open window holds a zero phi_D of D (:mod:`intervalkin.solve.window_plane`): the same, with that
   window replaced by its two halves, once on each SIDE of the plane of double roots s(phi_D; rho^2) = 0 (a null
   set, in no node), each side's nodes retracting only along directions that keep it.
+* a leaf with one cusp window beside pair windows (and windows of fixed count): one node per pattern and side of
+  the cusp window, retracting along the straight directions that keep both (source ``cusp_pattern``).
 * any other leaf whose windows are all firm: one node per signature they allow, with no way out (it tells a
   neighbour of another signature that it need not wait, which a LEFT leaf cannot).
 
@@ -60,10 +62,13 @@ from intervalkin.space.retraction_ranks import LEFT, RET, SINK, retraction_ranks
 
 __all__ = ["SINK", "RET", "LEFT", "SOURCES", "MAX_ROOTS", "MAX_PAIR_WINDOWS", "JointRetraction", "retract_joint_paving"]
 
-#: What a node is: a clear leaf, a fold piece, a window piece (window-clear leaf or window fold), a pattern of
-#: pair windows, a side of a cusp window (one root or three), or a LEFT leaf with no model of its pieces (its
-#: signature unknown).  The builders of :mod:`intervalkin.space.retraction_nodes` pass their index.
-SOURCES = ("clear", "fold_piece", "window_piece", "pair_pattern", "cusp_side", "signature_only", "no_piece_model")
+#: What a node is, in order: a clear leaf, a fold piece, a window piece (window-clear leaf or window fold), a pattern
+#: of pair windows, a side of a cusp window (one root or three), a signature of a leaf whose windows fit no other
+#: node, a LEFT leaf with no model of its pieces (its signature unknown), a side of a cusp window beside pair windows
+#: (added last, so the earlier indices keep their meaning).  The builders of :mod:`intervalkin.space.retraction_nodes`
+#: pass their index.
+SOURCES = ("clear", "fold_piece", "window_piece", "pair_pattern", "cusp_side", "signature_only", "no_piece_model",
+           "cusp_pattern")
 
 
 @dataclass(frozen=True, eq=False)
@@ -153,7 +158,7 @@ def retract_joint_paving(jp, geometry: Geometry, workers: Workers | None = None)
     if jp.windows is not None:
         covered[jp.windows.leaf[left_rows]] = False  # a window row without nodes: its leaf is LEFT
     left = np.flatnonzero(~covered)
-    nodes.add(left, -np.ones((left.size, 3)), LEFT, len(SOURCES) - 1, -1, np.zeros((1, 6), dtype=bool))
+    nodes.add(left, -np.ones((left.size, 3)), LEFT, SOURCES.index("no_piece_model"), -1, np.zeros((1, 6), dtype=bool))
     (leaf, sig, kind, source, cell, side), opt_node, opt_mask, opt_dir = nodes.table()
     rank, exit_ = retraction_ranks(jp.paving, leaf, sig, kind, opt_node, opt_mask, side)
     return JointRetraction(leaf, sig, kind, source, cell, opt_node, opt_mask, opt_dir, rank, exit_, side,

@@ -1,8 +1,8 @@
 """The nodes of the joint retraction: which sets cover each leaf's part of a signature, and their ways out.
 
 :func:`~intervalkin.space.joint_retraction.retract_joint_paving` ranks them; this module builds them, one
-source at a time (clear leaves, fold pieces, window pieces, patterns of pair windows, cusp sides, signature-only
-leaves).  Each node carries its OPTIONS, (k, 6) masks of the faces a straight segment (or a lifted path) from any
+source at a time (clear leaves, fold pieces, window pieces, patterns of pair windows, cusp sides, cusp sides beside
+pair windows, signature-only leaves).  Each node carries its OPTIONS, (k, 6) masks of the faces a straight segment (or a lifted path) from any
 of its points reaches while keeping the node's signature, with the direction it moves along; what makes an option
 certified is stated at each builder and proved in proofs/lemma-joint-retraction.md.
 """
@@ -17,7 +17,7 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
 from intervalkin.solve.fold_model import height_slopes
-from intervalkin.solve.window_cusp import cusp_direction_signs, cusp_retractions, cusp_windows
+from intervalkin.solve.window_cusp import cusp_adds, cusp_direction_signs, cusp_retractions, cusp_windows
 from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, STEADY, base_signature, pair_direction_signs,
                                           pair_windows, window_kinds)
 from intervalkin.solve.window_model import DET_SIGN
@@ -31,8 +31,9 @@ __all__ = ["Nodes", "MAX_ROOTS", "MAX_PAIR_WINDOWS", "PAIR_HALVINGS", "DIRECTION
 #: f is a trigonometric polynomial of degree 3 (not identically 0): no joint vector has more solutions, so a
 #: node (a pattern, a cusp side, a window fold's piece) that would hold more is empty and is dropped.
 MAX_ROOTS = 6
-#: Window-modelled leaves with more pair windows than this that may hold roots are LEFT (2**k patterns each).
-MAX_PAIR_WINDOWS = 3
+#: Window-modelled leaves with more live pair windows than this get signature-only nodes (2**k patterns each; a pattern
+#: of more than MAX_ROOTS roots is empty and dropped, so 6 leaves none out: 3 -> 6 opened 431 leaves fewer on the paper's paving).
+MAX_PAIR_WINDOWS = 6
 #: Halvings of the pair windows' critical pieces before their direction signs are read.  More come out free of
 #: roots or with a proved direction, at a cost that grows with the joined sub-windows' many pieces: on the paper's
 #: paving 40 005 leaves stay open at 1 (21 s), 37 304 at 2 (41 s).  The retraction runs in the paper run's
@@ -214,9 +215,15 @@ def window_nodes(jp, geometry: Geometry, nodes: Nodes, workers: Workers | None =
     base = base_signature(models)
     nodes.add(win.leaf[fixed], base[fixed], RET, 2, -1, EACH_FACE, plane=(split, fixed))
     rows = np.flatnonzero(open_rows & only_pairs & (n_pair >= 1))
-    if rows.size:
-        signs, free = pair_direction_signs(geometry, models, rows, DIRECTIONS, halvings=PAIR_HALVINGS, at_roots=True,
-                                           workers=workers)
+    # one cusp window, pair windows and windows of fixed count besides it: a node per pattern and cusp side
+    cusp = cusp_windows(models)
+    with_cusp = np.flatnonzero(open_rows & (n_pair >= 1) & (np.bincount(box, weights=cusp, minlength=n) == 1)
+                               & (np.bincount(box, weights=~pair & ~constant & ~cusp, minlength=n) == 0))
+    cusp_rows = np.zeros(0, dtype=np.int64)
+    if rows.size or with_cusp.size:
+        # each window's signs come from its own box: the pattern rows' are those they would have alone
+        signs, free = pair_direction_signs(geometry, models, np.union1d(rows, with_cusp), DIRECTIONS,
+                                           halvings=PAIR_HALVINGS, at_roots=True, workers=workers)
         # a free window (no critical piece: u > 0 on the whole box) never holds roots and keeps every direction,
         # so only the others make patterns
         live = pair & ~free
@@ -234,6 +241,7 @@ def window_nodes(jp, geometry: Geometry, nodes: Nodes, workers: Workers | None =
                 at = _within_rolle(split, constant, wins, real)
                 nodes.add(win.leaf[rk[at]], base[rk[at]] + int(real.sum()) * PAIR, RET, 3, -1,
                           *_direction_options(keeps[at]), plane=(split, rk[at]))
+        cusp_rows = _cusp_pattern_nodes(geometry, models, split, with_cusp, live, signs, nodes, win.leaf, workers)
     # one cusp window, the others of fixed count: a node for each side (one root, three roots), lifted paths (not
     # where a plane cuts the leaf: they may cross it)
     crows = _cusp_nodes(geometry, models, open_rows & (split.plane == 0), nodes, win.leaf, workers)
@@ -241,6 +249,7 @@ def window_nodes(jp, geometry: Geometry, nodes: Nodes, workers: Workers | None =
     done[rows] = True
     done[fixed] = True
     done[crows] = True
+    done[cusp_rows] = True
     # runs of sub-windows whose Rolle bound is 4 with end signs that differ hold one or three roots: cusp windows too
     done[_cusp_nodes(geometry, joined_windows(win.models, max_degree=4), open_rows & ~done, nodes, win.leaf,
                      workers)] = True
@@ -276,9 +285,47 @@ def _cusp_nodes(geometry: Geometry, models, rows: np.ndarray, nodes: Nodes, leaf
     return crows
 
 
+def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, live: np.ndarray, pair_signs: np.ndarray,
+                        nodes: Nodes, leaf_of_row: np.ndarray, workers: Workers | None = None) -> np.ndarray:
+    """The nodes of the rows (m,) with one cusp window, pair windows and windows of fixed count: one per pattern of
+    the live pair windows (``live``, their signs ``pair_signs``) and side of the cusp window (one root, three roots);
+    returns the rows given nodes (those with at most MAX_PAIR_WINDOWS live pair windows).
+
+    Each window's roots stay in its own arc of phi, so a straight segment keeps such a node when it keeps every
+    window's part: each pair window its pattern (as for the pattern nodes), the cusp window its side (the straight
+    ways of :func:`~intervalkin.solve.window_cusp.cusp_direction_signs`: +1 keeps the one-root side, -1 the
+    three-root side, STEADY both), the windows of fixed count their one root whatever the segment.  Lifted paths
+    are not offered: they keep the cusp window's root, not the pair windows'."""
+    box, n = models.window_box, len(models.ok)
+    n_live = np.bincount(box, weights=live, minlength=n)
+    rows = rows[n_live[rows] <= MAX_PAIR_WINDOWS]
+    if not rows.size:
+        return rows
+    base = base_signature(models)
+    constant = window_kinds(models)[3]
+    cusp = np.flatnonzero(cusp_windows(models) & np.isin(box, rows))  # one per row, in row order
+    side_signs = cusp_direction_signs(geometry, models, rows, DIRECTIONS, workers)[cusp]
+    adds = cusp_adds(models, cusp)
+    for k in range(MAX_PAIR_WINDOWS + 1):  # k = 0: every pair window free of roots, the cusp window alone
+        pick = np.flatnonzero(n_live[rows] == k)
+        if not pick.size:
+            continue
+        rk = rows[pick]
+        wins = np.flatnonzero(live & np.isin(box, rk)).reshape(rk.size, k)
+        for pattern in range(1 << k):
+            real = np.array([(pattern >> i) & 1 for i in range(k)], dtype=np.int64)
+            keeps = ((pair_signs[wins] * (1 - 2 * real)[None, :, None] == 1) | (pair_signs[wins] == STEADY)).all(axis=1)
+            at = _within_rolle(split, constant, wins, real)
+            for side, want in ((0, 1), (1, -1)):
+                both = keeps & ((side_signs[pick] == want) | (side_signs[pick] == STEADY))
+                nodes.add(leaf_of_row[rk[at]], base[rk[at]] + int(real.sum()) * PAIR + adds[pick[at], side], RET, 7,
+                          -1, *_direction_options(both[at]), plane=(split, rk[at]))
+    return rows
+
+
 def _signature_nodes(models, rows: np.ndarray, nodes: Nodes, leaf_of_row: np.ndarray) -> np.ndarray:
-    """Rows (n,) bool whose windows are all firm but fit no node above (a cusp window beside pair windows, more
-    pair windows than MAX_PAIR_WINDOWS, a union of degree 4 to 6): one node per signature they allow, with no way
+    """Rows (n,) bool whose windows are all firm but fit no node above (two cusp windows, more live pair windows
+    than MAX_PAIR_WINDOWS, a union of degree 4 to 6): one node per signature they allow, with no way
     out; returns the rows given nodes.  A firm window of degree d holds at most d roots (Rolle); they alternate
     in the sign of f', and D has one sign on it, so their det A signs alternate too.  Ends that differ: an odd
     number, the first and the last crossing as the ends say (one root of the aspect of the crossing rule, and
