@@ -32,7 +32,7 @@ __all__ = ["Nodes", "MAX_ROOTS", "MAX_PAIR_WINDOWS", "PAIR_HALVINGS", "DIRECTION
 #: node (a pattern, a cusp side, a window fold's piece) that would hold more is empty and is dropped.
 MAX_ROOTS = 6
 #: Window-modelled leaves with more live pair windows than this get signature-only nodes (2**k patterns each; a pattern
-#: of more than MAX_ROOTS roots is empty and dropped, so 6 leaves none out: 3 -> 6 opened 431 leaves fewer on the paper's paving).
+#: of more than MAX_ROOTS roots is empty and dropped; 3 -> 6 left 431 fewer leaves open on the paper's paving).
 MAX_PAIR_WINDOWS = 6
 #: Halvings of the pair windows' critical pieces before their direction signs are read.  More come out free of
 #: roots or with a proved direction, at a cost that grows with the joined sub-windows' many pieces: on the paper's
@@ -234,10 +234,8 @@ def window_nodes(jp, geometry: Geometry, nodes: Nodes, workers: Workers | None =
             if not rk.size:
                 continue
             wins = np.flatnonzero(live & np.isin(box, rk)).reshape(rk.size, k)  # windows are sorted by box
-            for pattern in range(1 << k):
-                real = np.array([(pattern >> i) & 1 for i in range(k)], dtype=np.int64)
-                # u_i must not fall where window i is empty, not rise where it holds its two roots
-                keeps = ((signs[wins] * (1 - 2 * real)[None, :, None] == 1) | (signs[wins] == STEADY)).all(axis=1)
+            for real in _patterns(k):
+                keeps = _pattern_keeps(signs[wins], real)
                 at = _within_rolle(split, constant, wins, real)
                 nodes.add(win.leaf[rk[at]], base[rk[at]] + int(real.sum()) * PAIR, RET, 3, -1,
                           *_direction_options(keeps[at]), plane=(split, rk[at]))
@@ -285,6 +283,18 @@ def _cusp_nodes(geometry: Geometry, models, rows: np.ndarray, nodes: Nodes, leaf
     return crows
 
 
+def _patterns(k: int):
+    """The 2**k patterns of k pair windows: (k,) int64, 1 where the window holds its two roots."""
+    for pattern in range(1 << k):
+        yield np.array([(pattern >> i) & 1 for i in range(k)], dtype=np.int64)
+
+
+def _pattern_keeps(signs: np.ndarray, real: np.ndarray) -> np.ndarray:
+    """(m, c) bool from the signs (m, k, c) of the pattern's k windows: the directions along which no u_i falls where
+    window i is empty and none rises where it holds its two roots (or the window is STEADY)."""
+    return ((signs * (1 - 2 * real)[None, :, None] == 1) | (signs == STEADY)).all(axis=1)
+
+
 def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, live: np.ndarray, pair_signs: np.ndarray,
                         nodes: Nodes, leaf_of_row: np.ndarray, workers: Workers | None = None) -> np.ndarray:
     """The nodes of the rows (m,) with one cusp window, pair windows and windows of fixed count: one per pattern of
@@ -312,9 +322,8 @@ def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, liv
             continue
         rk = rows[pick]
         wins = np.flatnonzero(live & np.isin(box, rk)).reshape(rk.size, k)
-        for pattern in range(1 << k):
-            real = np.array([(pattern >> i) & 1 for i in range(k)], dtype=np.int64)
-            keeps = ((pair_signs[wins] * (1 - 2 * real)[None, :, None] == 1) | (pair_signs[wins] == STEADY)).all(axis=1)
+        for real in _patterns(k):
+            keeps = _pattern_keeps(pair_signs[wins], real)
             at = _within_rolle(split, constant, wins, real)
             for side, want in ((0, 1), (1, -1)):
                 both = keeps & ((side_signs[pick] == want) | (side_signs[pick] == STEADY))
