@@ -9,8 +9,8 @@ import pytest
 
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.simple_roots import ReducedBoxes
-from intervalkin.solve.window_cusp import AXIS_PAIRS, cusp_retractions, cusp_windows
-from intervalkin.solve.window_fold import base_signature
+from intervalkin.solve.window_cusp import AXIS_PAIRS, cusp_retractions, cusp_windows, lifted_pair_signs
+from intervalkin.solve.window_fold import base_signature, critical_pieces, pair_windows, window_kinds
 from intervalkin.solve.window_union import joined_windows
 
 
@@ -134,3 +134,93 @@ def test_unions_read_as_cusp_windows_hold_one_or_three_roots(fold_paving, paper_
             seen[len(inside)] = seen.get(len(inside), 0) + 1
     assert seen and set(seen) <= {1, 3}, seen
     assert sum(seen.values()) >= 100
+
+
+def _grad(geometry, r: np.ndarray, phi: float) -> np.ndarray:
+    """df/dr at (phi; r), floats."""
+    rho = np.sqrt(r)
+    data = ReducedBoxes(geometry, np.stack([rho, rho], axis=-1)[None])
+    own, at = np.zeros(1, dtype=np.int64), np.array([phi])
+    return np.array([float(data.r_slope(own, at, at, i).mid()[0]) for i in range(3)])
+
+
+@pytest.fixture(scope="module")
+def beside_pairs(fold_paving, paper_geometry):
+    """Boxes with one cusp window, pair windows beside it and otherwise windows of fixed count (the cusp patterns'
+    boxes), their lifted ways and the signs of the pair windows along them (both sides, side-major)."""
+    models = fold_paving.windows.models
+    cusp, pair = cusp_windows(models), pair_windows(models)
+    n = len(models.ok)
+    constant = window_kinds(models)[3]
+    count = lambda w: np.bincount(models.window_box, weights=w, minlength=n)  # noqa: E731
+    rows = np.flatnonzero(models.ok & (count(cusp) == 1) & (count(pair) >= 1) & (count(~pair & ~constant & ~cusp) == 0))
+    cr = cusp_retractions(paper_geometry, models, rows)
+    signs = lifted_pair_signs(paper_geometry, models, rows, np.concatenate([cr.drive_u] * 2, axis=1),
+                              np.concatenate([cr.follow_v] * 2, axis=1), cr.follow_lo.reshape(rows.size, -1),
+                              cr.follow_hi.reshape(rows.size, -1), 1)
+    return models, rows, cr, signs
+
+
+def test_pair_signs_along_lifted_ways_hold_at_sampled_points(beside_pairs, paper_geometry):
+    """Property test (proofs/lemma-joint-retraction.md, "Cusp patterns: lifted paths"): where
+    :func:`lifted_pair_signs` gives a pair window a sign for a way, s (D_u f - q D_v f) has that sign at points
+    (r, phi, q) sampled in the box, the window's critical pieces and the way's hull of q.  An enclosure that lost
+    a term, or a sign taken without s, fails."""
+    models, rows, cr, signs = beside_pairs
+    k = cr.faces.shape[2]
+    slot = np.full(len(models.ok), -1, dtype=np.int64)
+    slot[rows] = np.arange(rows.size)
+    data = ReducedBoxes(paper_geometry, models.boxes[rows])
+    on = np.isin(models.piece_window, np.flatnonzero(np.any(signs != 0, axis=1)))
+    pw, lo, hi = critical_pieces(data, slot[models.window_box], models.end_signs[:, 0].astype(np.int64),
+                                 models.piece_window[on], models.piece_lo[on], models.piece_hi[on], 1)
+    rng = np.random.default_rng(17)
+    checked, seen_signs = 0, set()
+    for j in rng.permutation(pw.size)[:150]:
+        w = pw[j]
+        i = slot[models.window_box[w]]
+        box = models.boxes[models.window_box[w]]
+        s = float(models.end_signs[w, 0])
+        for way in np.flatnonzero(signs[w]):
+            q_lo = cr.follow_lo.reshape(rows.size, -1)[i, way]
+            q_hi = cr.follow_hi.reshape(rows.size, -1)[i, way]
+            u, v = cr.drive_u[i, way % k], cr.follow_v[i, way % k]
+            for _ in range(2):
+                rho = box[:, 0] + rng.random(3) * (box[:, 1] - box[:, 0])
+                phi = lo[j] + rng.random() * (hi[j] - lo[j])
+                q = q_lo + rng.random() * (q_hi - q_lo)
+                g = _grad(paper_geometry, rho**2, phi)
+                value = s * (g @ u - q * (g @ v))
+                assert np.sign(value) == signs[w, way], (w, way, rho, phi, q, value)
+                checked += 1
+                seen_signs.add(int(signs[w, way]))
+    assert checked >= 100 and seen_signs == {-1, 1}, (checked, seen_signs)
+
+
+def test_the_follow_rate_lies_in_its_hull_at_the_followed_root(beside_pairs, paper_geometry):
+    """Property test against independent certified solves: at sampled points of a side (one root or three in the
+    cusp window), q = f_u / f_v at the followed root (the single one, or the middle of three) lies in the way's
+    hull [follow_lo, follow_hi] for every way with a drive: the velocity set of the pair windows' signs holds the
+    path's velocity."""
+    models, rows, cr, _ = beside_pairs
+    rng = np.random.default_rng(19)
+    checked = 0
+    for i in rng.permutation(rows.size)[:60]:
+        on = models.piece_window == cr.window[i]
+        wa, wb = models.piece_lo[on][0], models.piece_hi[on][-1]
+        if wa >= wb or not cr.drive[i].any():
+            continue
+        box = models.boxes[rows[i]]
+        for _ in range(4):
+            x = box[:, 0] + rng.random(3) * (box[:, 1] - box[:, 0])
+            got = _signature(paper_geometry, x)
+            if got is None:
+                continue
+            inside = sorted(p for p in got[1] if wa <= p <= wb)
+            side = int(len(inside) == 3)
+            g = _grad(paper_geometry, x**2, inside[len(inside) // 2])
+            for way in np.flatnonzero(cr.drive[i, side]):
+                q = (g @ cr.drive_u[i, way]) / (g @ cr.follow_v[i, way])
+                assert cr.follow_lo[i, side, way] - 1e-9 * abs(q) <= q <= cr.follow_hi[i, side, way] + 1e-9 * abs(q)
+                checked += 1
+    assert checked >= 30, checked

@@ -45,10 +45,13 @@ from intervalkin.core.interval import Interval, sign_label
 from intervalkin.core.workers import Workers
 from intervalkin.solve.root_directions import piece_direction_signs, with_singular_signs
 from intervalkin.solve.simple_roots import ReducedBoxes
-from intervalkin.solve.window_fold import MIN_PARALLEL_BOXES, STEADY, agreed_signs, window_kinds, window_parts
+from intervalkin.solve.window_fold import (MIN_PARALLEL_BOXES, STEADY, agreed_signs, critical_pieces, pair_windows,
+                                          window_kinds, window_parts)
+from intervalkin.solve.window_split import aligned_r_slopes
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
-__all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_adds", "cusp_retractions", "cusp_windows", "cusp_direction_signs"]
+__all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_adds", "cusp_retractions", "cusp_windows", "cusp_direction_signs",
+           "lifted_pair_signs"]
 
 #: Halvings of a cusp window's pieces before the slopes are read.
 HALVINGS = 0
@@ -67,6 +70,8 @@ class CuspRetractions:
         lifted path (all False where the way proves nothing; every face of a way must be resolved).
     drive : (m, 2, k) int8, d: r moves along d u while the followed root is held by moving along v.
     drive_u, follow_v : (m, k, 3) the vectors u and v of each way (in r = rho^2).
+    follow_lo, follow_hi : (m, 2, k) an enclosure of q = f_u / f_v at the followed root, for each side and way: along
+        the way r' = d (u - q v) (where d != 0; an empty hull, lo > hi, where the side has no piece for its root).
     """
 
     rows: np.ndarray
@@ -76,6 +81,8 @@ class CuspRetractions:
     drive: np.ndarray
     drive_u: np.ndarray
     follow_v: np.ndarray
+    follow_lo: np.ndarray
+    follow_hi: np.ndarray
 
 
 def cusp_windows(models: WindowModels) -> np.ndarray:
@@ -118,8 +125,9 @@ def cusp_retractions(geometry: Geometry, models: WindowModels, rows: np.ndarray,
     faces = np.zeros((m, 2, k, 6), dtype=bool)
     drive = np.zeros((m, 2, k), dtype=np.int8)
     drive_u, follow_v = np.zeros((m, k, 3)), np.zeros((m, k, 3))
+    follow_lo, follow_hi = np.full((m, 2, k), np.inf), np.full((m, 2, k), -np.inf)
     if not m:
-        return CuspRetractions(rows, window, adds, faces, drive, drive_u, follow_v)
+        return CuspRetractions(rows, window, adds, faces, drive, drive_u, follow_v, follow_lo, follow_hi)
     on = np.isin(models.piece_window, window)
     pw, lo, hi = models.piece_window[on], models.piece_lo[on], models.piece_hi[on]
     pos = np.flatnonzero(on)  # a window's pieces are stored in circle order: their index is their position
@@ -151,12 +159,13 @@ def cusp_retractions(geometry: Geometry, models: WindowModels, rows: np.ndarray,
     # of the fold set {f = f_phi = 0} in it, both read at the box centre (floats: any fixed vectors will do)
     drive_u[:, -1], follow_v[:, -1] = _centre_directions(geometry, models.boxes[rows], owner, lo, hi, f == 0, m)
     for p in range(len(AXIS_PAIRS) + 1):
-        faces[:, :, p], drive[:, :, p] = _lifted_faces(f_r, f_phi_r, drive_u[:, p], follow_v[:, p], sets)
+        faces[:, :, p], drive[:, :, p], follow_lo[:, :, p], follow_hi[:, :, p] = _lifted_faces(
+            f_r, f_phi_r, drive_u[:, p], follow_v[:, p], sets)
     for side in (0, 1):  # a side proved empty (no piece can hold its root) retracts through any single face
         empty = np.bincount(owner, weights=at_root[side], minlength=m) == 0
         faces[empty, side] = np.eye(len(AXIS_PAIRS) + 1, 6, dtype=bool)[None]
         drive[empty, side] = 0
-    return CuspRetractions(rows, window, adds, faces, drive, drive_u, follow_v)
+    return CuspRetractions(rows, window, adds, faces, drive, drive_u, follow_v, follow_lo, follow_hi)
 
 
 def _hull(value: Interval, owner: np.ndarray, keep: np.ndarray, m: int) -> Interval:
@@ -183,19 +192,23 @@ def _combine(parts: list[Interval], w: np.ndarray) -> Interval:
 
 
 def _lifted_faces(f_r: list[Interval], f_phi_r: list[Interval], u: np.ndarray, v: np.ndarray,
-                  sets: dict) -> tuple[np.ndarray, np.ndarray]:
-    """((m, 2, 6) bool, (m, 2) int8): for each side (one root, three roots), the faces its lifted path may leave the
-    box through when r moves along d u, the followed root held by moving along v, and d (0 where nothing is
-    proved: no face)."""
+                  sets: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """((m, 2, 6) bool, (m, 2) int8, (m, 2) lo, (m, 2) hi): for each side (one root, three roots), the faces its
+    lifted path may leave the box through when r moves along d u, the followed root held by moving along v, d (0
+    where nothing is proved: no face), and the hull of q = f_u / f_v over the pieces where the side's root can be
+    (r' = d (u - q v) on the path)."""
     owner, m, e0, root = sets["owner"], sets["m"], sets["e0"], sets["root"]
     up, vp = u[owner], v[owner]
     fu, fv = _combine(f_r, up), _combine(f_r, vp)
     gu, gv = _combine(f_phi_r, up), _combine(f_phi_r, vp)
     out = np.zeros((m, 2, 6), dtype=bool)
     drives = np.zeros((m, 2), dtype=np.int8)
+    q_lo, q_hi = np.full((m, 2), np.inf), np.full((m, 2), -np.inf)
     for side in (0, 1):
         at = root[side]
         sv = _sign_over(fv, owner, at, m)
+        q = _hull(fu / fv, owner, at, m)  # f_v may vanish on a piece only where sv = 0, and then d = 0
+        q_lo[:, side], q_hi[:, side] = q.lo, q.hi
         if side == 1:  # d/dt f_phi at the middle root: J at one point of the window
             sk = _sign_over(gu * fv - gv * fu, owner, at, m)
         else:  # d/dt g(t) where f may vanish: f_phi,r between the root and t, the r-slopes at the root
@@ -213,7 +226,7 @@ def _lifted_faces(f_r: list[Interval], f_phi_r: list[Interval], u: np.ndarray, v
             out[:, side, 2 * i + 1] = (drive != 0) & ~still & (vel >= 0)
         out[~moving, side] = False  # no coordinate proved monotone: the path might never leave the box
         drives[:, side] = np.where(moving, drive, 0)
-    return out, drives
+    return out, drives, q_lo, q_hi
 
 
 def _centre_directions(geometry: Geometry, boxes: np.ndarray, owner: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -282,4 +295,41 @@ def cusp_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
                         fold=True, curvature=sigma.astype(np.int8))
     out[:] = agreed_signs(pw, folded, np.ones(pw.size, dtype=np.int8), quiet, w)
     out[cusp & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
+    return out
+
+
+def lifted_pair_signs(geometry: Geometry, models: WindowModels, rows: np.ndarray, u: np.ndarray, v: np.ndarray,
+                      q_lo: np.ndarray, q_hi: np.ndarray, halvings: int) -> np.ndarray:
+    """(w, k) int8 for the pair windows of boxes ``rows`` (m,) and k ways per box, u, v (m, k, 3) in r = rho^2 and
+    q in [q_lo, q_hi] (m, k): the sign of s (D_u f - q D_v f), s the window's end sign, proved over R^2 x every
+    critical piece of the window (:func:`~intervalkin.solve.window_fold.critical_pieces`, halved ``halvings``
+    times) and every such q; 0 where not proved or q's hull is empty.  Other windows: 0.
+
+    A lifted path of the box's cusp window moves r with velocity d (u - q v), q = f_u / f_v at the followed root
+    (:func:`cusp_retractions`), so u = min s f of a pair window moves along it with the sign of d times this one
+    wherever its minimum can sit (proofs/lemma-joint-retraction.md, "Cusp patterns: lifted paths").  df/dr_l is
+    enclosed as for the straight directions: the Taylor form's enclosure met with
+    :func:`~intervalkin.solve.window_split.aligned_r_slopes`."""
+    rows = np.asarray(rows, dtype=np.int64)
+    w, k = len(models.degree), u.shape[1]
+    out = np.zeros((w, k), dtype=np.int8)
+    even = pair_windows(models) & np.isin(models.window_box, rows)
+    if not even.any():
+        return out
+    on = np.isin(models.piece_window, np.flatnonzero(even))
+    row = np.full(len(models.ok), -1, dtype=np.int64)
+    row[rows] = np.arange(rows.size)
+    data = ReducedBoxes(geometry, models.boxes[rows])
+    s = models.end_signs[:, 0].astype(np.int64)
+    pw, lo, hi = critical_pieces(data, row[models.window_box], s, models.piece_window[on], models.piece_lo[on],
+                                 models.piece_hi[on], halvings)
+    owner = row[models.window_box][pw]
+    aligned = aligned_r_slopes(geometry, models.boxes[rows], owner, lo, hi)
+    grad = [data.r_slope(owner, lo, hi, axis).intersect(aligned[axis]) for axis in range(3)]
+    signs = np.zeros((pw.size, k), dtype=np.int8)
+    for way in range(k):
+        q = Interval(q_lo[owner, way], q_hi[owner, way])
+        value = _combine(grad, u[owner, way]) - q * _combine(grad, v[owner, way])
+        signs[:, way] = np.where(q.lo <= q.hi, sign_label(value), 0)
+    out[:] = agreed_signs(pw, signs, s[pw].astype(np.int8), np.zeros(pw.size, dtype=bool), w)
     return out

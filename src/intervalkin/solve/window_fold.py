@@ -52,7 +52,7 @@ from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced",
            "fold_piece", "extreme_corners", "base_signature", "window_kinds", "pair_windows", "pair_slopes",
-           "pair_direction_signs", "agreed_signs", "window_parts"]
+           "pair_direction_signs", "agreed_signs", "window_parts", "critical_pieces"]
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
@@ -208,7 +208,7 @@ def why_not_pieced(models: WindowModels, folds: WindowFolds) -> np.ndarray:
     return out
 
 
-def _critical(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, pw: np.ndarray, lo: np.ndarray,
+def critical_pieces(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, pw: np.ndarray, lo: np.ndarray,
               hi: np.ndarray, halvings: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The critical pieces (pw, lo, hi) of pair windows: where neither s f > 0 nor df/dphi != 0 is proved over
     R^2 x piece (the window's minimum of s f can only sit there), halved ``halvings`` times."""
@@ -231,7 +231,7 @@ def _slopes(data: ReducedBoxes, owner_of_window: np.ndarray, s: np.ndarray, w: i
     A window with no critical piece left has u > 0 on all of R (no root): every direction is
     valid for it, and +1 is returned.
     """
-    pw, lo, hi = _critical(data, owner_of_window, s, pw, lo, hi, halvings)
+    pw, lo, hi = critical_pieces(data, owner_of_window, s, pw, lo, hi, halvings)
     out = np.ones((w, 3), dtype=np.int8)
     owner = owner_of_window[pw]
     for axis in range(3):
@@ -283,7 +283,7 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     row[rows] = np.arange(rows.size)
     data = ReducedBoxes(geometry, models.boxes[rows])
     s = models.end_signs[:, 0].astype(np.int64)
-    pw, lo, hi = _critical(data, row[models.window_box], s, models.piece_window[on], models.piece_lo[on],
+    pw, lo, hi = critical_pieces(data, row[models.window_box], s, models.piece_window[on], models.piece_lo[on],
                            models.piece_hi[on], halvings)
     owner = row[models.window_box][pw]
     signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions, at_roots)

@@ -17,7 +17,8 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
 from intervalkin.solve.fold_model import height_slopes
-from intervalkin.solve.window_cusp import cusp_adds, cusp_direction_signs, cusp_retractions, cusp_windows
+from intervalkin.solve.window_cusp import (cusp_adds, cusp_direction_signs, cusp_retractions, cusp_windows,
+                                          lifted_pair_signs)
 from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, STEADY, base_signature, pair_direction_signs,
                                           pair_windows, window_kinds)
 from intervalkin.solve.window_model import DET_SIGN
@@ -304,8 +305,12 @@ def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, liv
     Each window's roots stay in its own arc of phi, so a straight segment keeps such a node when it keeps every
     window's part: each pair window its pattern (as for the pattern nodes), the cusp window its side (the straight
     ways of :func:`~intervalkin.solve.window_cusp.cusp_direction_signs`: +1 keeps the one-root side, -1 the
-    three-root side, STEADY both), the windows of fixed count their one root whatever the segment.  Lifted paths
-    are not offered: they keep the cusp window's root, not the pair windows'."""
+    three-root side, STEADY both), the windows of fixed count their one root whatever the segment.  A lifted path of
+    the cusp window (:func:`~intervalkin.solve.window_cusp.cusp_retractions`) keeps the node when it also keeps each
+    pair window's pattern: r moves with velocity d (u - q v), and s D_u f - q s D_v f is signed on the window's
+    critical pieces for every q of the way (:func:`~intervalkin.solve.window_cusp.lifted_pair_signs`); a side
+    proved empty keeps its (empty) node along any face.  Not where a plane cuts the leaf (``Nodes.add`` drops the
+    ways without a direction there: they may cross it)."""
     box, n = models.window_box, len(models.ok)
     n_live = np.bincount(box, weights=live, minlength=n)
     rows = rows[n_live[rows] <= MAX_PAIR_WINDOWS]
@@ -316,6 +321,12 @@ def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, liv
     cusp = np.flatnonzero(cusp_windows(models) & np.isin(box, rows))  # one per row, in row order
     side_signs = cusp_direction_signs(geometry, models, rows, DIRECTIONS, workers)[cusp]
     adds = cusp_adds(models, cusp)
+    lifted = cusp_retractions(geometry, models, rows)
+    ways = lifted.faces.shape[2]
+    # the ways of both sides at once, side-major: (rows, 2 ways, 3) and (rows, 2 ways)
+    way_signs = lifted_pair_signs(geometry, models, rows, np.concatenate([lifted.drive_u] * 2, axis=1),
+                                  np.concatenate([lifted.follow_v] * 2, axis=1), lifted.follow_lo.reshape(rows.size, -1),
+                                  lifted.follow_hi.reshape(rows.size, -1), PAIR_HALVINGS)
     for k in range(MAX_PAIR_WINDOWS + 1):  # k = 0: every pair window free of roots, the cusp window alone
         pick = np.flatnonzero(n_live[rows] == k)
         if not pick.size:
@@ -327,8 +338,15 @@ def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, liv
             at = _within_rolle(split, constant, wins, real)
             for side, want in ((0, 1), (1, -1)):
                 both = keeps & ((side_signs[pick] == want) | (side_signs[pick] == STEADY))
+                straight, direction = _direction_options(both[at])
+                drive = lifted.drive[pick[at], side].astype(np.int64)  # (m, ways)
+                along = drive[:, None, :] * way_signs[wins[at]][:, :, side * ways:(side + 1) * ways]
+                steady = (pair_signs[wins[at]][:, :, :1] == STEADY)
+                kept = _pattern_keeps(np.where(steady, STEADY, along), real) | (drive == 0)
+                options = np.concatenate([straight, lifted.faces[pick[at], side] & kept[..., None]], axis=1)
+                directions = np.concatenate([direction, np.zeros(kept.shape + (3,))], axis=1)
                 nodes.add(leaf_of_row[rk[at]], base[rk[at]] + int(real.sum()) * PAIR + adds[pick[at], side], RET, 7,
-                          -1, *_direction_options(both[at]), plane=(split, rk[at]))
+                          -1, options, directions, plane=(split, rk[at]))
     return rows
 
 
