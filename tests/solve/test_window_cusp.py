@@ -9,7 +9,8 @@ import pytest
 
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.simple_roots import ReducedBoxes
-from intervalkin.solve.window_cusp import AXIS_PAIRS, cusp_retractions, cusp_windows, lifted_pair_signs
+from intervalkin.solve.window_cusp import (AXIS_PAIRS, cusp_retractions, cusp_retractions_where, cusp_windows,
+                                          lifted_pair_signs)
 from intervalkin.solve.window_fold import base_signature, critical_pieces, pair_windows, window_kinds
 from intervalkin.solve.window_union import joined_windows
 
@@ -224,3 +225,16 @@ def test_the_follow_rate_lies_in_its_hull_at_the_followed_root(beside_pairs, pap
                 assert cr.follow_lo[i, side, way] - 1e-9 * abs(q) <= q <= cr.follow_hi[i, side, way] + 1e-9 * abs(q)
                 checked += 1
     assert checked >= 30, checked
+
+
+def test_ways_where_asked_are_those_of_the_rows_alone(beside_pairs, paper_geometry):
+    """``cusp_retractions_where``: the rows asked for get the ways :func:`cusp_retractions` gives them (each box's
+    ways come from its own box), the others none (no face, no drive, an empty hull of q), and every row its adds."""
+    models, rows, cr, _ = beside_pairs
+    where = np.arange(rows.size) % 3 == 0
+    got = cusp_retractions_where(paper_geometry, models, rows, cr.window, where)
+    for name in ("faces", "drive", "drive_u", "follow_v", "follow_lo", "follow_hi", "adds"):
+        assert np.array_equal(getattr(got, name)[where], getattr(cr, name)[where]), name
+    assert np.array_equal(got.adds, cr.adds) and np.array_equal(got.window, cr.window)
+    assert not got.faces[~where].any() and not got.drive[~where].any()
+    assert np.all(got.follow_lo[~where] > got.follow_hi[~where])

@@ -36,6 +36,7 @@ ways" in the same lemma).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,7 +52,7 @@ from intervalkin.solve.window_split import aligned_r_slopes
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_adds", "cusp_retractions", "cusp_windows", "cusp_direction_signs",
-           "lifted_pair_signs"]
+           "cusp_retractions_where", "lifted_pair_signs"]
 
 #: Halvings of a cusp window's pieces before the slopes are read.
 HALVINGS = 0
@@ -166,6 +167,21 @@ def cusp_retractions(geometry: Geometry, models: WindowModels, rows: np.ndarray,
         faces[empty, side] = np.eye(len(AXIS_PAIRS) + 1, 6, dtype=bool)[None]
         drive[empty, side] = 0
     return CuspRetractions(rows, window, adds, faces, drive, drive_u, follow_v, follow_lo, follow_hi)
+
+
+def cusp_retractions_where(geometry: Geometry, models: WindowModels, rows: np.ndarray, window: np.ndarray,
+                           where: np.ndarray) -> CuspRetractions:
+    """:func:`cusp_retractions` of ``rows`` (their cusp windows ``window``) with the ways computed only for the rows
+    ``where`` (m,) bool; the others get none (drive 0, no face, an empty hull of q), at no cost."""
+    at = np.flatnonzero(where)
+    got = cusp_retractions(geometry, models, rows[at])
+    m, k = rows.size, got.faces.shape[2]
+    ways = {"faces": np.zeros((m, 2, k, 6), dtype=bool), "drive": np.zeros((m, 2, k), dtype=np.int8),
+            "drive_u": np.zeros((m, k, 3)), "follow_v": np.zeros((m, k, 3)),
+            "follow_lo": np.full((m, 2, k), np.inf), "follow_hi": np.full((m, 2, k), -np.inf)}
+    for name, value in ways.items():
+        value[at] = getattr(got, name)
+    return dataclasses.replace(got, rows=rows, window=window, adds=cusp_adds(models, window), **ways)
 
 
 def _hull(value: Interval, owner: np.ndarray, keep: np.ndarray, m: int) -> Interval:

@@ -9,7 +9,6 @@ certified is stated at each builder and proved in proofs/lemma-joint-retraction.
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import math
 
@@ -18,8 +17,8 @@ import numpy as np
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
 from intervalkin.solve.fold_model import height_slopes
-from intervalkin.solve.window_cusp import (cusp_adds, cusp_direction_signs, cusp_retractions, cusp_windows,
-                                          lifted_pair_signs)
+from intervalkin.solve.window_cusp import (cusp_adds, cusp_direction_signs, cusp_retractions, cusp_retractions_where,
+                                          cusp_windows, lifted_pair_signs)
 from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, STEADY, base_signature, pair_direction_signs,
                                           pair_windows, window_kinds)
 from intervalkin.solve.window_model import DET_SIGN
@@ -322,7 +321,8 @@ def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, liv
     cusp = np.flatnonzero(cusp_windows(models) & np.isin(box, rows))  # one per row, in row order
     side_signs = cusp_direction_signs(geometry, models, rows, DIRECTIONS, workers)[cusp]
     adds = cusp_adds(models, cusp)
-    lifted = _uncut_lifted(geometry, models, split, rows, cusp)
+    # only leaves no plane cuts can use lifted ways (Nodes.add keeps segments alone on the others)
+    lifted = cusp_retractions_where(geometry, models, rows, cusp, split.plane[rows] == 0)
     ways = lifted.faces.shape[2]
     # the ways of both sides at once, side-major: (rows, 2 ways, 3) and (rows, 2 ways)
     way_signs = lifted_pair_signs(geometry, models, rows, np.concatenate([lifted.drive_u] * 2, axis=1),
@@ -349,21 +349,6 @@ def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, liv
                 nodes.add(leaf_of_row[rk[at]], base[rk[at]] + int(real.sum()) * PAIR + adds[pick[at], side], RET, 7,
                           -1, options, directions, plane=(split, rk[at]))
     return rows
-
-
-def _uncut_lifted(geometry: Geometry, models, split, rows: np.ndarray, window: np.ndarray):
-    """The lifted ways of ``rows`` (each with one cusp window, ``window``), computed only where no plane of double
-    roots cuts the leaf (the others could not use them: ``Nodes.add`` keeps only segments there); elsewhere no way
-    (drive 0, no face, an empty hull of q)."""
-    uncut = np.flatnonzero(split.plane[rows] == 0)
-    got = cusp_retractions(geometry, models, rows[uncut])
-    k = got.faces.shape[2]
-    out = {"faces": np.zeros((rows.size, 2, k, 6), dtype=bool), "drive": np.zeros((rows.size, 2, k), dtype=np.int8),
-           "drive_u": np.zeros((rows.size, k, 3)), "follow_v": np.zeros((rows.size, k, 3)),
-           "follow_lo": np.full((rows.size, 2, k), np.inf), "follow_hi": np.full((rows.size, 2, k), -np.inf)}
-    for name, value in out.items():
-        value[uncut] = getattr(got, name)
-    return dataclasses.replace(got, rows=rows, window=window, adds=cusp_adds(models, window), **out)
 
 
 def _signature_nodes(models, rows: np.ndarray, nodes: Nodes, leaf_of_row: np.ndarray) -> np.ndarray:
