@@ -49,7 +49,6 @@ def test_run_succeeds_quietly(run):
     assert r.stdout == ""
     assert "Traceback" not in r.stderr and "error" not in r.stderr.lower()
     assert "Warning:" not in r.stderr, r.stderr
-    assert seconds < 120
 
 
 def test_shallow_run_warns_of_nothing(tmp_path):
