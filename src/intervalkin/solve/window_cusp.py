@@ -46,7 +46,7 @@ from intervalkin.core.interval import Interval, sign_label
 from intervalkin.core.workers import Workers
 from intervalkin.solve.root_directions import piece_direction_signs, with_singular_signs
 from intervalkin.solve.simple_roots import ReducedBoxes
-from intervalkin.solve.window_fold import (MIN_PARALLEL_BOXES, STEADY, agreed_signs, critical_pieces, pair_windows,
+from intervalkin.solve.window_fold import (MIN_PARALLEL_BOXES, STEADY, agreed_signs, pair_critical, pair_windows,
                                           window_kinds, window_parts)
 from intervalkin.solve.window_split import aligned_r_slopes
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
@@ -332,14 +332,7 @@ def lifted_pair_signs(geometry: Geometry, models: WindowModels, rows: np.ndarray
     even = pair_windows(models) & np.isin(models.window_box, rows)
     if not even.any():
         return out
-    on = np.isin(models.piece_window, np.flatnonzero(even))
-    row = np.full(len(models.ok), -1, dtype=np.int64)
-    row[rows] = np.arange(rows.size)
-    data = ReducedBoxes(geometry, models.boxes[rows])
-    s = models.end_signs[:, 0].astype(np.int64)
-    pw, lo, hi = critical_pieces(data, row[models.window_box], s, models.piece_window[on], models.piece_lo[on],
-                                 models.piece_hi[on], halvings)
-    owner = row[models.window_box][pw]
+    data, s, pw, lo, hi, owner = pair_critical(geometry, models, rows, even, halvings)
     aligned = aligned_r_slopes(geometry, models.boxes[rows], owner, lo, hi)
     grad = [data.r_slope(owner, lo, hi, axis).intersect(aligned[axis]) for axis in range(3)]
     signs = np.zeros((pw.size, k), dtype=np.int8)

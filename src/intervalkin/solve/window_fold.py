@@ -52,7 +52,7 @@ from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["OPEN", "CLEAR", "FOLD", "PAIR", "STEADY", "WHY_NOT", "WindowFolds", "window_folds", "why_not_pieced",
            "fold_piece", "extreme_corners", "base_signature", "window_kinds", "pair_windows", "pair_slopes",
-           "pair_direction_signs", "agreed_signs", "window_parts", "critical_pieces"]
+           "pair_direction_signs", "agreed_signs", "window_parts", "critical_pieces", "pair_critical"]
 
 #: Kinds of window-modelled boxes.
 OPEN, CLEAR, FOLD = 0, 1, 2
@@ -278,14 +278,7 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     even = pair_windows(models) & np.isin(models.window_box, rows)
     if not even.any():
         return out, np.zeros(w, dtype=bool)
-    on = np.isin(models.piece_window, np.flatnonzero(even))
-    row = np.full(len(models.ok), -1, dtype=np.int64)
-    row[rows] = np.arange(rows.size)
-    data = ReducedBoxes(geometry, models.boxes[rows])
-    s = models.end_signs[:, 0].astype(np.int64)
-    pw, lo, hi = critical_pieces(data, row[models.window_box], s, models.piece_window[on], models.piece_lo[on],
-                           models.piece_hi[on], halvings)
-    owner = row[models.window_box][pw]
+    data, s, pw, lo, hi, owner = pair_critical(geometry, models, rows, even, halvings)
     signs, quiet = piece_direction_signs(geometry, models.boxes[rows], data, owner, lo, hi, directions, at_roots)
     free = even & (np.bincount(pw, minlength=w) == 0)
     if at_roots:  # what the elimination's forms leave open, from the singular poses (quiet pieces need nothing)
@@ -295,6 +288,19 @@ def pair_direction_signs(geometry: Geometry, models: WindowModels, rows: np.ndar
     # no root on any critical piece: u never vanishes on the box, whichever its sign (either pattern keeps)
     out[even & ~free & (np.bincount(pw, weights=~quiet, minlength=w) == 0)] = STEADY
     return out, free
+
+
+def pair_critical(geometry: Geometry, models: WindowModels, rows: np.ndarray, even: np.ndarray, halvings: int):
+    """(the ReducedBoxes of boxes ``rows``, the end signs s, and the critical pieces pw, lo, hi of the windows
+    ``even`` with their owners, rows of ``data``): what the direction signs of pair windows are read on."""
+    on = np.isin(models.piece_window, np.flatnonzero(even))
+    row = np.full(len(models.ok), -1, dtype=np.int64)
+    row[rows] = np.arange(rows.size)
+    data = ReducedBoxes(geometry, models.boxes[rows])
+    s = models.end_signs[:, 0].astype(np.int64)
+    pw, lo, hi = critical_pieces(data, row[models.window_box], s, models.piece_window[on], models.piece_lo[on],
+                                 models.piece_hi[on], halvings)
+    return data, s, pw, lo, hi, row[models.window_box][pw]
 
 
 def agreed_signs(window: np.ndarray, signs: np.ndarray, factor: np.ndarray, quiet: np.ndarray, w: int) -> np.ndarray:
