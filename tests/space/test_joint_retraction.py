@@ -18,8 +18,32 @@ from tests.solve.test_window_plane import _s_mp
 
 
 @pytest.fixture(scope="module")
-def retraction(fold_paving, paper_geometry):
-    return retract_joint_paving(fold_paving, paper_geometry)
+def corner_geometry():
+    """The paper's manipulator on the part [21, 32] x [15.5, 26.5] x [10, 21] of its joint box."""
+    from dataclasses import replace
+
+    from intervalkin.core.geometry import default_geometry
+
+    return replace(default_geometry(), rho_min=(Fraction(21), Fraction(31, 2), Fraction(10)),
+                   rho_max=(Fraction(32), Fraction(53, 2), Fraction(21)))
+
+
+@pytest.fixture(scope="module")
+def corner_paving(corner_geometry):
+    """That part paved as the shared ``fold_paving`` is (fold and window models, one model and one join level) at
+    depth 4, so with leaves of the same size (11/16 = 22/32).  Of the eighth-volume parts of the joint box it holds
+    the most leaves with cusp sides (420 of the whole box's 1707 on ``fold_paving``) beside the 6-solution cell,
+    crossings and zeros of D, so every kind of retraction node in numbers the property tests can sample; its
+    paving and retraction take about 45 s on one core, where the whole box's retraction alone took about 110 s.
+    Read only."""
+    from intervalkin.space.joint_paving import pave_joint_space
+
+    return pave_joint_space(corner_geometry, 4, 1, fold=True, model_levels=1, windows=True)
+
+
+@pytest.fixture(scope="module")
+def retraction(corner_paving, corner_geometry):
+    return retract_joint_paving(corner_paving, corner_geometry)
 
 
 def _signature(geometry, point) -> tuple[int, int, int] | None:
@@ -31,15 +55,15 @@ def _signature(geometry, point) -> tuple[int, int, int] | None:
     return len(res.solutions), n1, len(res.solutions) - n1
 
 
-def test_every_leaf_has_a_node_and_sinks_lie_in_counted_cells(fold_paving, retraction):
+def test_every_leaf_has_a_node_and_sinks_lie_in_counted_cells(corner_paving, retraction):
     r = retraction
     assert np.all(np.diff(r.leaf) >= 0)
-    assert np.array_equal(np.unique(r.leaf), np.arange(len(fold_paving.cell)))
+    assert np.array_equal(np.unique(r.leaf), np.arange(len(corner_paving.cell)))
     sink = r.kind == SINK
-    assert sink.any() and np.all(r.cell[sink] >= 0) and np.all(r.cell[sink] < len(fold_paving.cells))
+    assert sink.any() and np.all(r.cell[sink] >= 0) and np.all(r.cell[sink] < len(corner_paving.cells))
     assert np.all(r.cell[~sink] == -1) and np.all(r.rank[sink] == 0)
     # a sink's signature is its cell's
-    sigs = np.array([c.signature for c in fold_paving.cells])
+    sigs = np.array([c.signature for c in corner_paving.cells])
     assert np.array_equal(r.signature[sink], sigs[r.cell[sink]])
     # every source of node occurs on this paving, and LEFT nodes never get a rank
     assert set(np.unique(r.source)) == set(range(len(SOURCES)))
@@ -49,11 +73,11 @@ def test_every_leaf_has_a_node_and_sinks_lie_in_counted_cells(fold_paving, retra
     assert not r.closed()  # pair patterns and cusp sides without a way: no upper bound at this depth
 
 
-def test_ranks_follow_the_rule_across_each_exit_face(fold_paving, retraction):
+def test_ranks_follow_the_rule_across_each_exit_face(corner_paving, retraction):
     """Re-derived from the float boxes: every leaf sharing a 2-D piece of a resolved node's exit face holds no LEFT
     node, and its nodes of the same signature are sinks or of lower rank (but for those on the other side of the
     node's own plane of double roots, which its path never reaches)."""
-    r, p = retraction, fold_paving.paving
+    r, p = retraction, corner_paving.paving
     lo, hi = p.lo, p.hi
     resolved = np.flatnonzero((r.kind == RET) & (r.rank > 0))
     assert resolved.size > 100
@@ -79,12 +103,12 @@ def test_ranks_follow_the_rule_across_each_exit_face(fold_paving, retraction):
                 assert np.all((r.rank[same] >= 0) & (r.rank[same] < r.rank[node]))
 
 
-def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retraction, paper_geometry):
+def test_resolved_nodes_keep_their_signature_along_the_exit(corner_paving, retraction, corner_geometry):
     """Property test against independent certified solves: a point of a resolved node (of a signature no other node
     of its leaf has) keeps the node's signature on the segment along the exit direction up to the face: fold
     pieces, window pieces, pair patterns, cusp sides that leave along a segment (only pairs dying on the
     one-root side, only born on the three-root side), and cusp patterns (both kinds of window kept at once)."""
-    r, p = retraction, fold_paving.paving
+    r, p = retraction, corner_paving.paving
     rng = np.random.default_rng(11)
     checked = {name: 0 for name in SOURCES}
     straight = np.zeros(r.leaf.size, dtype=bool)  # nodes that left along a segment (cusp sides may use lifted paths)
@@ -100,7 +124,7 @@ def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retract
                 continue
             for _ in range(6):  # a point of the node: one of the node's signature (no other node of the leaf has it)
                 x = p.lo[a] + rng.random(3) * (p.hi[a] - p.lo[a])
-                if _signature(paper_geometry, x) == tuple(r.signature[node]):
+                if _signature(corner_geometry, x) == tuple(r.signature[node]):
                     break
             else:
                 continue
@@ -110,7 +134,7 @@ def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retract
             assert np.isfinite(reach) and reach >= 0
             for t in (0.25, 0.5, 0.75, 1.0):
                 y = np.clip(x + t * reach * e, p.lo[a], p.hi[a])
-                got = _signature(paper_geometry, y)
+                got = _signature(corner_geometry, y)
                 assert got is None or got == tuple(r.signature[node]), (SOURCES[source], node, y)
             checked[SOURCES[source]] += 1
     assert checked["fold_piece"] >= 10 and checked["window_piece"] >= 2 and checked["pair_pattern"] >= 20, checked
@@ -118,14 +142,14 @@ def test_resolved_nodes_keep_their_signature_along_the_exit(fold_paving, retract
     assert checked["cusp_pattern"] >= 10, checked  # a cusp side and pair patterns kept by one segment
 
 
-def test_fold_pieces_leave_sideways_where_the_sheet_keeps_them(fold_paving, retraction, paper_geometry):
+def test_fold_pieces_leave_sideways_where_the_sheet_keeps_them(corner_paving, retraction, corner_geometry):
     """Property test against independent certified solves: from a point of a fold piece (its signature, which
     the other piece of the box does not have), the segment along each sideways way (the sheet's slope proved)
     keeps the piece's signature up to the face.  Reversing the slope signs makes it fail."""
-    r, p = retraction, fold_paving.paving
-    k = fold_paving.pieces.models.axis
+    r, p = retraction, corner_paving.paving
+    k = corner_paving.pieces.models.axis
     axis_of = np.full(len(p.level), -1)
-    axis_of[fold_paving.pieces.box] = k
+    axis_of[corner_paving.pieces.box] = k
     opt = np.flatnonzero(r.source[r.option_node] == SOURCES.index("fold_piece"))
     face = np.argmax(r.option_faces[opt], axis=1)
     sideways = opt[face // 2 != axis_of[r.leaf[r.option_node[opt]]]]
@@ -138,7 +162,7 @@ def test_fold_pieces_leave_sideways_where_the_sheet_keeps_them(fold_paving, retr
         a = r.leaf[node]
         for _ in range(8):
             x = p.lo[a] + rng.random(3) * (p.hi[a] - p.lo[a])
-            if _signature(paper_geometry, x) == tuple(r.signature[node]):
+            if _signature(corner_geometry, x) == tuple(r.signature[node]):
                 break
         else:
             continue
@@ -148,7 +172,7 @@ def test_fold_pieces_leave_sideways_where_the_sheet_keeps_them(fold_paving, retr
         for t in (0.2, 0.4, 0.6, 0.8, 1.0):
             y = x.copy()
             y[ax] = x[ax] + t * (end - x[ax])
-            got = _signature(paper_geometry, y)
+            got = _signature(corner_geometry, y)
             assert got is None or got == tuple(r.signature[node]), (node, x, y)
         checked += 1
         if checked == 30:
@@ -156,14 +180,14 @@ def test_fold_pieces_leave_sideways_where_the_sheet_keeps_them(fold_paving, retr
     assert checked >= 20, checked
 
 
-def test_plane_side_nodes_keep_their_side_and_signature_along_the_exit(fold_paving, retraction, paper_geometry):
+def test_plane_side_nodes_keep_their_side_and_signature_along_the_exit(corner_paving, retraction, corner_geometry):
     """Property test: a point of a resolved node on one side of a plane of double roots (the 50-digit sign of
     s(phi_D; rho^2) at the zero phi_D of D), of the node's signature (no other node of its leaf and side has
     it), keeps its side and its signature along the exit segment up to the face."""
-    r, p = retraction, fold_paving.paving
+    r, p = retraction, corner_paving.paving
     mpmath.mp.dps = 50
-    d_coeff = _d_mp(paper_geometry)
-    zeros = [mpmath.findroot(lambda x: _mp_value(d_coeff, x), mpmath.mpf(float(z))) for z in d_zeros(paper_geometry)]
+    d_coeff = _d_mp(corner_geometry)
+    zeros = [mpmath.findroot(lambda x: _mp_value(d_coeff, x), mpmath.mpf(float(z))) for z in d_zeros(corner_geometry)]
     sided = np.flatnonzero((r.side != 0) & (r.rank > 0))
     assert sided.size >= 10
     rng = np.random.default_rng(17)
@@ -177,8 +201,8 @@ def test_plane_side_nodes_keep_their_side_and_signature_along_the_exit(fold_pavi
             continue
         for _ in range(8):
             x = p.lo[a] + rng.random(3) * (p.hi[a] - p.lo[a])
-            if (mpmath.sign(_s_mp(paper_geometry, x, phi_d)) == np.sign(side)
-                    and _signature(paper_geometry, x) == tuple(r.signature[node])):
+            if (mpmath.sign(_s_mp(corner_geometry, x, phi_d)) == np.sign(side)
+                    and _signature(corner_geometry, x) == tuple(r.signature[node])):
                 break
         else:
             continue
@@ -188,8 +212,8 @@ def test_plane_side_nodes_keep_their_side_and_signature_along_the_exit(fold_pavi
         reach = min(reach, np.min(np.where(e < 0, (p.lo[a] - x) / np.where(e < 0, e, -1), np.inf)))
         for t in (0.5, 1.0):
             y = np.clip(x + t * reach * e, p.lo[a], p.hi[a])
-            assert mpmath.sign(_s_mp(paper_geometry, y, phi_d)) == np.sign(side), (node, y)
-            got = _signature(paper_geometry, y)
+            assert mpmath.sign(_s_mp(corner_geometry, y, phi_d)) == np.sign(side), (node, y)
+            got = _signature(corner_geometry, y)
             assert got is None or got == tuple(r.signature[node]), (node, y)
         checked += 1
     assert checked >= 5, checked
@@ -266,14 +290,14 @@ def test_the_fixed_point_on_a_small_tiling():
         assert (rank[c1] == 1 and rank[c2] == 1) if resolved else (rank[c1] == -1 and rank[c2] == -1)
 
 
-def test_the_nodes_of_a_leaf_cover_the_signatures_of_its_points(fold_paving, retraction, paper_geometry):
+def test_the_nodes_of_a_leaf_cover_the_signatures_of_its_points(corner_paving, retraction, corner_geometry):
     """Property test against independent certified solves: at sampled points of leaves with cusp sides or
     signature-only nodes (including those read from unions of runs of degree 4 to 6), of leaves with pair
     patterns and of leaves with a cusp window beside pair windows (cusp patterns), the signature is one of the
     leaf's nodes' (a node set that missed it would let a neighbour of that signature retract through the leaf
     without waiting).  Fails if a union's crossing root or its pairs are
     dropped from the signature-only nodes, or its lifted sides are added with the wrong aspects."""
-    r, p = retraction, fold_paving.paving
+    r, p = retraction, corner_paving.paving
     rng = np.random.default_rng(17)
     start = np.searchsorted(r.leaf, np.arange(len(p.lo) + 1))
     checked = {}
@@ -282,17 +306,17 @@ def test_the_nodes_of_a_leaf_cover_the_signatures_of_its_points(fold_paving, ret
         for a in rng.choice(leaves, min(80, leaves.size), replace=False):
             sigs = {tuple(s) for s in r.signature[start[a]:start[a + 1]]}
             for _ in range(2):
-                got = _signature(paper_geometry, p.lo[a] + rng.random(3) * (p.hi[a] - p.lo[a]))
+                got = _signature(corner_geometry, p.lo[a] + rng.random(3) * (p.hi[a] - p.lo[a]))
                 if got is not None:
                     assert got in sigs, (source, a, got, sorted(sigs))
                     checked[source] = checked.get(source, 0) + 1
     assert all(checked.get(s, 0) >= 60 for s in ("cusp_side", "signature_only", "pair_pattern", "cusp_pattern")), checked
 
 
-def test_the_summary_reports_the_retraction(fold_paving, retraction):
+def test_the_summary_reports_the_retraction(corner_paving, retraction):
     from dataclasses import replace
 
-    block = replace(fold_paving, retraction=retraction).open_places()["retraction"]
+    block = replace(corner_paving, retraction=retraction).open_places()["retraction"]
     assert block["closed"] is False
     assert block["nodes"] == retraction.leaf.size
     assert block["sinks"] + block["resolved"] + block["unresolved"] == block["nodes"]
@@ -300,8 +324,8 @@ def test_the_summary_reports_the_retraction(fold_paving, retraction):
     sided = retraction.side != 0
     assert block["plane_sides"]["nodes"] == sided.sum() > 0
     assert block["plane_sides"]["unresolved"] == (sided & (retraction.rank < 0)).sum()
-    assert 0 < block["volume_unresolved"] <= fold_paving.paving.volume().sum()
-    assert "retraction" not in fold_paving.open_places()
+    assert 0 < block["volume_unresolved"] <= corner_paving.paving.volume().sum()
+    assert "retraction" not in corner_paving.open_places()
 
 
 def _window_count(geometry, point, lo: np.ndarray, hi: np.ndarray) -> int | None:
@@ -314,7 +338,7 @@ def _window_count(geometry, point, lo: np.ndarray, hi: np.ndarray) -> int | None
     return sum(any(a <= p + k * 2 * np.pi <= b for k in (-1, 0, 1) for a, b in zip(lo, hi)) for p in phis)
 
 
-def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_geometry):
+def test_signs_at_the_roots_keep_the_window_status_along_e(corner_paving, corner_geometry):
     """Property test of pair_direction_signs(at_roots=True) (proofs/lemma-joint-retraction.md, pattern nodes): where
     it proves a direction the signs over whole pieces did not, or calls a window STEADY, the number of solutions in
     the window (an independent certified solve) stays the same from a point of the box along e up to its boundary:
@@ -326,19 +350,19 @@ def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_ge
     from intervalkin.solve.window_union import joined_windows
     from intervalkin.space.retraction_nodes import DIRECTIONS
 
-    win = fold_paving.windows
-    split = split_at_zeros_of_d(paper_geometry, joined_windows(win.models))
+    win = corner_paving.windows
+    split = split_at_zeros_of_d(corner_geometry, joined_windows(win.models))
     models = split.models
     # a sample of the boxes with a pair window beside a zero of D, where the signs at the roots tell most
     apart = np.min([np.maximum(np.maximum(models.piece_lo - z, z - models.piece_hi), 0)
-                    for z in d_zeros(paper_geometry)], axis=0)  # each piece's distance to the zeros of D
+                    for z in d_zeros(corner_geometry)], axis=0)  # each piece's distance to the zeros of D
     gap = np.full(len(models.degree), np.inf)
     np.minimum.at(gap, models.piece_window, apart)
     near = np.unique(models.window_box[pair_windows(models) & (gap < 0.1) & models.ok[models.window_box]])
     rng = np.random.default_rng(17)
     rows = np.sort(rng.choice(near, size=min(near.size, 2500), replace=False))
-    old, _ = pair_direction_signs(paper_geometry, models, rows, DIRECTIONS, at_roots=False)
-    new, _ = pair_direction_signs(paper_geometry, models, rows, DIRECTIONS, at_roots=True)
+    old, _ = pair_direction_signs(corner_geometry, models, rows, DIRECTIONS, at_roots=False)
+    new, _ = pair_direction_signs(corner_geometry, models, rows, DIRECTIONS, at_roots=True)
     assert np.all((old == 0) | (new == old) | (new == STEADY))
     gained = np.flatnonzero(pair_windows(models) & ((old == 0) & (new != 0)).any(axis=1))
     assert gained.size >= 100
@@ -350,7 +374,7 @@ def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_ge
         x = box[:, 0] + rng.random(3) * (box[:, 1] - box[:, 0])
         own = models.piece_window == w
         pieces = models.piece_lo[own], models.piece_hi[own]
-        status = _window_count(paper_geometry, x, *pieces)
+        status = _window_count(corner_geometry, x, *pieces)
         if status is None:
             continue
         assert status in (0, 2)
@@ -361,20 +385,20 @@ def test_signs_at_the_roots_keep_the_window_status_along_e(fold_paving, paper_ge
         # a half of a window cut at phi_D speaks for its box's points on one side of the plane s(phi_D; r) = 0 (its
         # nodes only move along directions that keep their side): the walk stops where it would cross the plane
         cut = split.plane[models.window_box[w]]
-        phi_d = d_zeros(paper_geometry)[cut - 1] if cut else None
-        side = mpmath.sign(_s_mp(paper_geometry, x, phi_d)) if cut else 0
+        phi_d = d_zeros(corner_geometry)[cut - 1] if cut else None
+        side = mpmath.sign(_s_mp(corner_geometry, x, phi_d)) if cut else 0
         for t in (0.2, 0.4, 0.6, 0.8, 1.0):
             y = np.clip(x + t * reach * e, box[:, 0], box[:, 1])
-            if cut and mpmath.sign(_s_mp(paper_geometry, y, phi_d)) != side:
+            if cut and mpmath.sign(_s_mp(corner_geometry, y, phi_d)) != side:
                 break
-            got = _window_count(paper_geometry, y, *pieces)
+            got = _window_count(corner_geometry, y, *pieces)
             assert got is None or got == status, (w, DIRECTIONS[c], way, t, status, got)
         checked += 1
         steady += bool(new[w, c] == STEADY)
     assert checked >= 40, checked
 
 
-def test_the_direction_signs_split_between_processes_are_the_serial_ones(fold_paving, paper_geometry, monkeypatch):
+def test_the_direction_signs_split_between_processes_are_the_serial_ones(corner_paving, corner_geometry, monkeypatch):
     """pair_direction_signs cut into parts for two processes returns exactly the serial arrays (each part runs on its
     boxes' models alone, and the windows are put back where take() found them).  Rows are given unsorted and with a
     box twice, as a caller may."""
@@ -385,15 +409,15 @@ def test_the_direction_signs_split_between_processes_are_the_serial_ones(fold_pa
     from intervalkin.solve.window_union import joined_windows
     from intervalkin.space.retraction_nodes import DIRECTIONS
 
-    models = split_at_zeros_of_d(paper_geometry, joined_windows(fold_paving.windows.models)).models
+    models = split_at_zeros_of_d(corner_geometry, joined_windows(corner_paving.windows.models)).models
     boxes = np.unique(models.window_box[pair_windows(models) & models.ok[models.window_box]])
     rng = np.random.default_rng(5)
     rows = rng.choice(boxes, size=min(boxes.size, 300), replace=False)
     rows = np.r_[rows, rows[:1]]
-    serial = pair_direction_signs(paper_geometry, models, rows, DIRECTIONS, at_roots=True)
+    serial = pair_direction_signs(corner_geometry, models, rows, DIRECTIONS, at_roots=True)
     monkeypatch.setattr(window_fold, "MIN_PARALLEL_BOXES", 40)
     with Workers(2) as workers:
-        parts = pair_direction_signs(paper_geometry, models, rows, DIRECTIONS, at_roots=True, workers=workers)
+        parts = pair_direction_signs(corner_geometry, models, rows, DIRECTIONS, at_roots=True, workers=workers)
     assert (serial[0] != 0).sum() > 100  # signs were proved, so a misplaced window would show
     for a, b in zip(serial, parts):
         assert a.dtype == b.dtype and np.array_equal(a, b)
