@@ -108,12 +108,25 @@ def _refused(d: Path, capsys, file: str, claim: str | None = None) -> str:
 # --------------------------------------------------------------------------------------
 # Honest certificates
 # --------------------------------------------------------------------------------------
-def test_every_claim_of_the_chain_verifies(cert_dir, capsys):
-    # one run of the command (re-proving every claim twice would double the suite's longest test)
-    code = main(["verify", str(cert_dir)])
-    out = capsys.readouterr().out.splitlines()
-    assert out and code == 0, [ln for ln in out if not ln.startswith("verified: ")]
-    assert all(ln.startswith("verified: ") for ln in out)
+@pytest.fixture(scope="module")
+def checked(cert_dir):
+    """One re-proof of the whole folder by the checker alone, in a fresh process: {"lines": its verdict lines, as
+    ``intervalkin verify`` prints them, "modules": the modules of the checked layers it imported}.  One run serves
+    both tests below (re-proving every claim twice would double the file's longest test)."""
+    code = (
+        "import json, sys, intervalkin.checker as c\n"
+        f"r = c.verify_directory({str(cert_dir)!r})\n"
+        "layers = ['kinematics', 'paving', 'solve', 'space', 'certify', 'pipeline', 'app']\n"
+        "mods = sorted(m for m in sys.modules for l in layers if m == 'intervalkin.' + l or m.startswith('intervalkin.' + l + '.'))\n"
+        "print(json.dumps({'lines': [x.line() for x in r], 'modules': mods}))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return json.loads(out.stdout)
+
+
+def test_every_claim_of_the_chain_verifies(cert_dir, checked):
+    out = checked["lines"]
+    assert out and all(ln.startswith("verified: ") for ln in out), [ln for ln in out if not ln.startswith("verified: ")]
     kinds = {ln.split(" (", 1)[1].split(")", 1)[0] for ln in out}
     assert kinds == set(checker.KINDS)
     written = sum(len(_load(cert_dir, f)["claims"]) for f in _load(cert_dir, "index.json")["files"])
@@ -423,16 +436,8 @@ def test_bad_sample_size_refused(tmp_path, paper_geometry):
 # --------------------------------------------------------------------------------------
 # Independence: the checker runs without the code it checks
 # --------------------------------------------------------------------------------------
-def test_checker_imports_none_of_the_checked_modules(cert_dir):
-    code = (
-        "import sys, intervalkin.checker as c\n"
-        f"r = c.verify_directory({str(cert_dir)!r})\n"
-        "assert r and all(x.verified for x in r), [x.line() for x in r if not x.verified]\n"
-        "layers = ['kinematics', 'paving', 'solve', 'space', 'certify', 'pipeline', 'app']\n"
-        "print(sorted(m for m in sys.modules for l in layers if m == 'intervalkin.' + l or m.startswith('intervalkin.' + l + '.')))\n"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "[]", out.stdout + out.stderr
+def test_checker_imports_none_of_the_checked_modules(checked):
+    assert checked["lines"] and checked["modules"] == [], checked["modules"]
 
 
 # --------------------------------------------------------------------------------------
