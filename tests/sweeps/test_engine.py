@@ -1,7 +1,7 @@
 """The sweep on a real LocalCluster of 2 workers: a worker killed mid-sweep, the cache, the resume.
 
-Twelve designs around the paper's manipulator (platform scale 0.8..1.2 x rho_max 34..40) at
-depth 4 (about 2 s each; tests/sweeps/shared.py).  The cluster is started once for the
+Six designs around the paper's manipulator (platform scale 0.8..1.2 x rho_max 34 and 40) at
+depth 4 (about 2 s each on a quiet machine; the grid of tests/sweeps/shared.py with two of its four rho_max).  The cluster is started once for the
 module; the first sweep kills one worker (SIGKILL) while it is analysing a design, and the tests
 check that every design still has exactly one result; the later sweeps reuse its cache.
 """
@@ -20,7 +20,10 @@ import tomllib
 
 import intervalkin
 from intervalkin.sweeps.spec import parse_sweep
-from tests.sweeps.shared import GRID
+from tests.sweeps.shared import GRID as _FULL_GRID
+
+#: six designs: enough for a worker to die with designs still queued, half the twelve's cost
+GRID = _FULL_GRID.replace("[34, 36, 38, 40]", "[34, 40]")
 
 distributed = pytest.importorskip("distributed")
 dask = pytest.importorskip("dask")
@@ -44,7 +47,7 @@ def cluster():
 
 @pytest.fixture(scope="module")
 def killed_run(cluster, tmp_path_factory):
-    """The 12-design sweep, during which one worker busy with a design is killed; (result, cache, killed pid)."""
+    """The 6-design sweep, during which one worker busy with a design is killed; (result, cache, killed pid)."""
     c, client = cluster
     cache = tmp_path_factory.mktemp("sweep-cache")
     killed = {}
@@ -69,11 +72,11 @@ def killed_run(cluster, tmp_path_factory):
 def test_a_worker_killed_mid_sweep_leaves_every_design_exactly_once(killed_run, cluster):
     result, cache, killed = killed_run
     _, client = cluster
-    assert killed["at"] == 1  # killed after the first result, with 11 designs to go
+    assert killed["at"] == 1  # killed after the first result, with 5 designs to go
     assert killed["pid"] not in client.run(os.getpid).values()  # it died (the nanny started a new one)
-    assert sorted(r["design"] for r in result.rows) == list(range(12))
-    assert [r["status"] for r in result.rows] == ["ok"] * 12, [r["error"] for r in result.rows]
-    assert len(result.computed) == 12 and result.reused == () and result.workers == 2
+    assert sorted(r["design"] for r in result.rows) == list(range(6))
+    assert [r["status"] for r in result.rows] == ["ok"] * 6, [r["error"] for r in result.rows]
+    assert len(result.computed) == 6 and result.reused == () and result.workers == 2
     files = sorted(p.name for p in cache.iterdir())
     assert files == sorted(f"{r['key']}.json" for r in result.rows)  # one cached result per design, no other file
     doc = json.loads((cache / files[0]).read_text())
@@ -90,23 +93,23 @@ def test_counts_are_copied_with_their_bounds(killed_run):
         assert 0 <= r["volume_largest_uniqueness_domain"] <= r["volume_W"]
         assert r["seconds"] > 0 and r["memory_mb"] > 0
     table = result.table()
-    assert table.num_rows == 12 and table.column("platform.scale").to_pylist()[:4] == [0.8] * 4
+    assert table.num_rows == 6 and table.column("platform.scale").to_pylist()[:2] == [0.8] * 2
 
 
 def test_a_rerun_does_no_work_and_a_changed_parameter_computes_only_new_designs(killed_run, cluster):
     first, cache, _ = killed_run
     c, _ = cluster
     again = intervalkin.sweep(_spec(GRID), cache=cache, scheduler="tcp://127.0.0.1:1")  # never contacted
-    assert again.computed == () and len(again.reused) == 12 and again.workers == 0
-    assert [r["cached"] for r in again.rows] == [True] * 12
+    assert again.computed == () and len(again.reused) == 6 and again.workers == 0
+    assert [r["cached"] for r in again.rows] == [True] * 6
     assert [r["basic_regions_found"] for r in again.rows] == [r["basic_regions_found"] for r in first.rows]
 
-    changed = intervalkin.sweep(_spec(GRID.replace("[34, 36, 38, 40]", "[32, 36, 38, 40]")), cache=cache,
+    changed = intervalkin.sweep(_spec(GRID.replace("[34, 40]", "[32, 40]")), cache=cache,
                                 scheduler=c.scheduler_address)
     new = [r["key"] for r in changed.rows if r["limits.rho_max"] == 32]
     assert sorted(changed.computed) == sorted(new) and len(new) == 3
-    assert len(changed.reused) == 9
-    assert len(list(cache.iterdir())) == 15
+    assert len(changed.reused) == 3
+    assert len(list(cache.iterdir())) == 9
 
 
 def test_degenerate_designs_are_rows_and_do_not_stop_the_others(cluster, tmp_path):
