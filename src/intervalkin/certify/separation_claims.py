@@ -264,8 +264,8 @@ def pattern_barriers(jp, geometry: Geometry, precision: int = 128,
     return out, omitted
 
 
-def separation_claims(geometry: Geometry, jp, precision: int = 128,
-                      patterned: Beside | None = None) -> tuple[list[dict], dict, list[dict]]:
+def separation_claims(geometry: Geometry, jp, precision: int = 128, patterned: Beside | None = None,
+                      budget: int = PATTERN_BUDGET) -> tuple[list[dict], dict, list[dict]]:
     """(claims, npz arrays, omitted) of ``certificates/joint_separation.json`` and ``.npz``.
 
     Claim j: ``cell``, ``signature``, ``witness`` and ``others`` (each a witness object with its
@@ -277,10 +277,11 @@ def separation_claims(geometry: Geometry, jp, precision: int = 128,
     ``pattern_rows``: sorted arc starts padded with -2).
 
     ``patterned``: :func:`pattern_barriers` of the same paving, already started in a second process (a
-    :class:`~intervalkin.core.workers.Beside`), so that its serial flood runs while this process does the rest."""
+    :class:`~intervalkin.core.workers.Beside`), so that its serial flood runs while this process does the rest;
+    otherwise they are made here, with ``budget`` ranged faces in all."""
     with Workers(default_workers(), min_items=MIN_PART) as workers:
         barriers, omitted = count_barriers(jp, geometry, workers=workers)
-    made, left = patterned.result() if patterned is not None else pattern_barriers(jp, geometry, precision)
+    made, left = patterned.result() if patterned is not None else pattern_barriers(jp, geometry, precision, budget)
     omitted += left
     claims: list[dict] = []
     arrays = {k: [] for k in _COLUMNS}
