@@ -52,14 +52,20 @@ def test_run_succeeds_quietly(run):
 
 
 def test_shallow_run_warns_of_nothing(tmp_path):
-    """At depth 3 no joint cell has a certified count: the figures are drawn all the same, and
+    """At depth 3 no joint cell has a certified count: the figures are drawn all the same,
     --quiet leaves stderr without a Python warning (e.g. matplotlib's "No artists with labels"
-    from a legend over an empty scatter)."""
+    from a legend over an empty scatter), and ``verify`` accepts the folder."""
     r = subprocess.run([sys.executable, "-m", "intervalkin", "paper", "--depth", "3", "--out", str(tmp_path / "run"),
                         "--quiet"], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     assert "Warning:" not in r.stderr, r.stderr
     assert (tmp_path / "run" / "figures" / "joint_3d.png").is_file()
+    # the counts of so shallow a run still agree with their certificates (the aspects' covers prove 2 there while
+    # the regions paving certifies no box of either sign: a count of 0 was refused as below its certificates)
+    v = subprocess.run([sys.executable, "-m", "intervalkin", "verify", str(tmp_path / "run")], capture_output=True,
+                       text=True, timeout=300)
+    assert v.returncode == 0, v.stdout + v.stderr
+    assert json.loads((tmp_path / "run" / "summary.json").read_text())["aspects"]["lower"] == 2
 
 
 def test_documented_files_are_written_completely(run, summary):

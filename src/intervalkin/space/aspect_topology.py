@@ -179,11 +179,21 @@ class AspectTopology:
     def lower(self, found: Count) -> int:
         """The lower bound of ``found`` (distinct signs) raised by the separations of the closed covers.
 
-        A sign witnessed by ``found`` counts 1 there; its closed cover proves ``separated`` components,
-        so it adds ``separated - 1`` (a sign not witnessed by ``found`` is then under-counted by one:
-        still a lower bound, and the checker's own bound is never below it).
+        Per sign of det A, the larger of 1 when ``found`` witnesses the sign and the ``separated`` pieces of its
+        closed cover (each holds a sink, so each lies in its own component), summed over the signs: the checker's
+        bound (``checker.claims.count_bound``), which the count must never fall below.  ``found`` says how many
+        signs it witnesses, not which: with one, the smaller of the two assignments is taken.  A cover's sinks
+        prove its sign's part of W nonempty even where ``found`` has no certified box of it (a shallow paving).
         """
-        return found.lower + sum(max(c.separated - 1, 0) for c in self.covers if c.closed)
+        sep = {c.sign: (c.separated if c.closed else 0) for c in self.covers}
+        a, b = sep.get(1, 0), sep.get(-1, 0)
+        if found.lower >= 2:
+            bound = max(1, a) + max(1, b)
+        elif found.lower == 1:
+            bound = min(max(1, a) + b, a + max(1, b))
+        else:
+            bound = a + b
+        return max(bound, found.lower)
 
     def count(self, found: Count) -> Count:
         """The aspect count ``found`` (its lower bound from opposite signs) with the covers' bounds added.
@@ -200,11 +210,11 @@ class AspectTopology:
             return Count(n, lower, None, False, found.why + f"; components per sign {per_sign}; the covers of the two "
                          f"signs leave {left} boxes undecided (listed under \"covers\"), so no upper bound is proved")
         groups = " + ".join(str(c.groups) for c in self.covers)
-        cut = lower > found.lower
+        proofs = ["opposite certified signs of det A" if found.lower >= 2 else "a certified sign of det A"][:found.lower]
+        if lower > found.lower:
+            proofs.append("the sinks of the closed covers, in pieces of each sign's part of W that OUT boxes cut apart")
         return Count(n, lower, upper, upper == lower,
-                     f"at least {lower}: opposite certified signs of det A"
-                     + (", and OUT boxes of the covers cutting a sign's part of W into pieces that each hold "
-                        "a sink" if cut else "")
+                     f"at least {lower}: " + ", and ".join(proofs or ["nothing certified"])
                      + f"; at most {upper} = {groups}: for each sign, a cover of the domain by boxes free of it, "
                      "inside it (face-connected groups of sinks) or retracting onto the sinks along certified "
                      "monotone directions proves that its part of W has at most one component per group "
