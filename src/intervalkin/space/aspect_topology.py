@@ -212,7 +212,8 @@ class AspectTopology:
         groups = " + ".join(str(c.groups) for c in self.covers)
         proofs = ["opposite certified signs of det A" if found.lower >= 2 else "a certified sign of det A"][:found.lower]
         if lower > found.lower:
-            proofs.append("the sinks of the closed covers, in pieces of each sign's part of W that OUT boxes cut apart")
+            proofs.append("the sinks of the closed covers, with OUT boxes cutting a sign's part of W into pieces that "
+                          "each hold a sink")
         return Count(n, lower, upper, upper == lower,
                      f"at least {lower}: " + ", and ".join(proofs or ["nothing certified"])
                      + f"; at most {upper} = {groups}: for each sign, a cover of the domain by boxes free of it, "
