@@ -210,7 +210,9 @@ class AspectTopology:
             return Count(n, lower, None, False, found.why + f"; components per sign {per_sign}; the covers of the two "
                          f"signs leave {left} boxes undecided (listed under \"covers\"), so no upper bound is proved")
         groups = " + ".join(str(c.groups) for c in self.covers)
-        proofs = ["opposite certified signs of det A" if found.lower >= 2 else "a certified sign of det A"][:found.lower]
+        proofs = []
+        if found.lower:
+            proofs.append("opposite certified signs of det A" if found.lower >= 2 else "a certified sign of det A")
         if lower > found.lower:
             proofs.append("the sinks of the closed covers, with OUT boxes cutting a sign's part of W into pieces that "
                           "each hold a sink")
