@@ -202,7 +202,7 @@ class FoldProof:
 
 
 def _cross(model: ArbModel, m: int, n: int):
-    """u_m x u_n (u_l = B_l - A_l) as a function of (x, y, phi), products only (for hyper-dual arguments)."""
+    """u_m x u_n (u_l = B_l - A_l) as a function of (x, y, phi), products only (for jet arguments, checker.taylor)."""
     def u(l, x, y, phi):
         ax, ay = model.A[l]
         if l == 0:

@@ -155,7 +155,7 @@ class ArbModel:
 
 
 def leg_sq(model: ArbModel, l: int):
-    """rho_l^2 as a function of (x, y, phi) with products only (for hyper-dual arguments)."""
+    """rho_l^2 as a function of (x, y, phi) with products only (for jet arguments, checker.taylor)."""
     ax, ay = model.A[l]
 
     def f(x, y, phi):
