@@ -15,16 +15,26 @@ from intervalkin.core.geometry import default_geometry
 DATA = Path(__file__).parent / "data"
 
 
-def built_once(tmp_path_factory, name: str, build):
+#: The temporary folder the xdist workers of this run share (set at the start of each worker's session).
+_SHARED_ROOT: list[Path] = []
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _shared_root(tmp_path_factory):
+    _SHARED_ROOT[:] = [tmp_path_factory.getbasetemp().parent]
+
+
+def shared_value(name: str, build):
     """``build()``, computed by one xdist worker of the run and read by the others from a pickle.
 
     Session fixtures are per worker: a paving read by test files that land on both workers would be
     paved twice (the windowed depth-5 one costs about 30 s).  The first worker to ask builds it under
     an exclusive lock in the run's shared temporary folder; a worker asking later waits for the lock and
-    loads the file.  Each worker gets its own copy, so the fixtures stay read-only by convention only."""
-    if os.environ.get("PYTEST_XDIST_WORKER") is None:
+    loads the file.  Each worker gets its own copy, so the values stay read-only by convention only.
+    Outside xdist (or before the session has started) it is simply built."""
+    root = shared_root()
+    if root is None:
         return build()
-    root = tmp_path_factory.getbasetemp().parent  # shared by the workers of one run
     path = root / f"{name}.pickle"
     with open(root / f"{name}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
@@ -35,6 +45,20 @@ def built_once(tmp_path_factory, name: str, build):
         part.write_bytes(pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL))
         part.replace(path)  # a worker never reads half a file
         return value
+
+
+def shared_root() -> Path | None:
+    """The folder the xdist workers of this run share; None outside xdist (nothing to share)."""
+    if os.environ.get("PYTEST_XDIST_WORKER") is None or not _SHARED_ROOT:
+        return None
+    return _SHARED_ROOT[0]
+
+
+def built_once(tmp_path_factory, name: str, build):
+    """:func:`shared_value` for a session fixture (the fixture asks for ``tmp_path_factory`` so that the shared
+    folder is known)."""
+    _SHARED_ROOT[:] = [tmp_path_factory.getbasetemp().parent]
+    return shared_value(name, build)
 
 
 @pytest.fixture(scope="session")

@@ -23,11 +23,14 @@ from intervalkin.app.report_html import write_report_html
 from intervalkin.app.summary import chain_summary
 from intervalkin.app.vtk_export import write_exports
 
+from ..conftest import shared_root, shared_value
+
 
 @functools.lru_cache(maxsize=None)
 def chain(depth: int):
-    """``intervalkin.analyse(depth=depth)`` (depth 6: about 2 s, 16 basic regions, 7 uniqueness domains)."""
-    return intervalkin.analyse(depth=depth)
+    """``intervalkin.analyse(depth=depth)`` (depth 6: about 17 s on one core, 16 basic regions, 7 uniqueness
+    domains), made once a run: five test files read it, on either worker (tests/conftest.py: shared_value)."""
+    return shared_value(f"analysis-depth-{depth}", lambda: intervalkin.analyse(depth=depth))
 
 
 @functools.lru_cache(maxsize=None)
@@ -35,10 +38,19 @@ def paper_folder(depth: int = 6) -> tuple[Path, dict]:
     """An output folder of the chain at ``depth`` with every figure, export and both reports; (folder, summary).
 
     Written with the same calls as the paper command: the figures, the VTK exports, report.md,
-    then report.html.  Removed when the test process ends.
-    """
-    out = Path(tempfile.mkdtemp(prefix="intervalkin-paper-"))
-    atexit.register(shutil.rmtree, out, ignore_errors=True)
+    then report.html.  Written once a run (two test files read it, on either worker) in a folder that outlives
+    the worker that wrote it: the run's shared temporary folder under xdist, else one removed at exit.
+    Read it only."""
+    return shared_value(f"paper-folder-depth-{depth}", lambda: _write_paper_folder(depth))
+
+
+def _write_paper_folder(depth: int) -> tuple[Path, dict]:
+    root = shared_root()
+    if root is None:
+        out = Path(tempfile.mkdtemp(prefix="intervalkin-paper-"))
+        atexit.register(shutil.rmtree, out, ignore_errors=True)
+    else:
+        out = Path(tempfile.mkdtemp(prefix="intervalkin-paper-", dir=root))
     a = chain(depth)
     ra = a.regions
     write_npz(out / "pavings" / "workspace.npz", ra.paving, ra.aspect,
