@@ -55,6 +55,23 @@ def test_add_sub_mul_sqr_enclose_the_exact_results(a, b):
     assert sqr(ia)[0][0] >= 0.0
 
 
+_EDGES = [0.0, -0.0, 5e-324, -5e-324, 2.0 ** -1022, -(2.0 ** -1022), 2.0 ** -970, 2.0 ** -971, 1.0, -1.0, 2.0 ** 52,
+          math.nextafter(1.0, 0.0), math.nextafter(2.0, 3.0), -math.nextafter(4.0, 0.0), 1e300, -1e300, 3.0, 6.0]
+
+
+@settings(max_examples=2000, deadline=None)
+@given(st.one_of(st.sampled_from(_EDGES), st.floats(allow_nan=False, allow_infinity=False, width=64)))
+def test_outward_steps_pass_the_next_float_and_stay_close(v):
+    """down(v) is at or below the next float toward -inf and up(v) at or above the next toward +inf, for every
+    finite v (zero, subnormals, powers of two, the gap floor and the largest magnitudes included); and they stay
+    within a few ulps (a step that jumped far would make every enclosure useless)."""
+    lo, hi = float(arith.down(np.array([v]))[0]), float(arith.up(np.array([v]))[0])
+    assert lo <= math.nextafter(v, -math.inf) and hi >= math.nextafter(v, math.inf)
+    if abs(v) < 1e307:
+        gap = max(math.ulp(v), 2.0 ** -1022)
+        assert Fraction(v) - Fraction(lo) <= 3 * Fraction(gap) and Fraction(hi) - Fraction(v) <= 3 * Fraction(gap)
+
+
 def test_products_of_exact_values_are_still_widened():
     """An exact product is widened by an ulp anyway (the rule is 'step every bound', not 'guess exactness')."""
     lo, hi = mul((np.array([3.0]), np.array([3.0])), (np.array([2.0]), np.array([2.0])))

@@ -7,7 +7,7 @@ arithmetic and of the formulas, on purpose: it imports neither the library's
 rounding layer (:mod:`intervalkin.core.interval`, :mod:`intervalkin.core.ball`)
 nor its kinematics, paving, solver or space code (the import-linter contract in
 ``pyproject.toml``), so a slip there cannot hide itself here.  Its trusted base
-is numpy's correctly rounded +, -, * and ``nextafter``, numpy's cos and sin
+is numpy's correctly rounded +, -, * (outward steps included), numpy's cos and sin
 within a documented margin, python-flint for the two constants L_i and alpha_i
 of the geometry, and, for the few labels the float pass leaves open, the arb
 checker (:mod:`intervalkin.checker.labels`).  The argument is
