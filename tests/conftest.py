@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
+import io
 import os
 import pickle
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -162,11 +165,19 @@ def second_aspect_topology(second_geometry):
 
 @pytest.fixture(scope="session")
 def analyze_depth4(tmp_path_factory) -> Path:
-    """``intervalkin analyze --depth 4 --out DIR --quiet`` of the paper's manipulator (about 10 s, most of it
-    the figures), written once per session for app/test_output_folder.py and checker/test_consistency.py.
-    Read it only: a test that changes files copies it first."""
+    """``intervalkin analyze --depth 4 --out DIR --quiet --json`` of the paper's manipulator (about 25 s, most of it
+    the figures and certificates), written once a run for app/test_output_folder.py, checker/test_consistency.py
+    and app/test_commands.py, on either worker; what it printed is in DIR/../stdout.txt.  Read it only: a test
+    that changes files copies it first."""
     from intervalkin.app.cli import main
 
-    out = tmp_path_factory.mktemp("analyze-depth4") / "out"
-    assert main(["analyze", "--depth", "4", "--out", str(out), "--quiet"]) == 0
-    return out
+    def build() -> Path:
+        out = Path(tempfile.mkdtemp(prefix="analyze-depth4-", dir=shared_root() or tmp_path_factory.getbasetemp()))
+        printed = io.StringIO()
+        with contextlib.redirect_stdout(printed):
+            status = main(["analyze", "--depth", "4", "--out", str(out / "out"), "--quiet", "--json"])
+        assert status == 0
+        (out / "stdout.txt").write_text(printed.getvalue())
+        return out / "out"
+
+    return shared_value("analyze-depth4", build)

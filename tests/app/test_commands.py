@@ -49,11 +49,13 @@ def test_outputs_and_summary_schema(analysed):
     assert all((analysed / f).exists() for f in s["files"])
 
 
-def test_json_prints_one_object(tmp_path, capsys):
-    assert main(["analyze", "--depth", "4", "--out", str(tmp_path / "o"), "--quiet", "--json"]) == 0
-    out = capsys.readouterr().out
+def test_json_prints_one_object(analyze_depth4):
+    """``analyze --depth 4 --quiet --json`` (the run of tests/conftest.py): one line, the summary written."""
+    out = (analyze_depth4.parent / "stdout.txt").read_text()
     assert out.count("\n") == 1
-    assert json.loads(out)["aspects"]["count"] == 2
+    printed = json.loads(out)
+    assert printed["aspects"]["count"] == 2
+    assert printed == json.loads((analyze_depth4 / "summary.json").read_text())
 
 
 def test_refuses_a_foreign_non_empty_folder(tmp_path, capsys):
@@ -187,12 +189,17 @@ def test_refinement_deepens_until_consistent_or_limit():
 
 
 @pytest.mark.parametrize("depth, extra", [(4, []), (5, ["--refine-to", "6"])])
-def test_files_written_beside_the_joint_paving_or_after_it_are_the_regions_of_the_summary(tmp_path, depth, extra):
+def test_files_written_beside_the_joint_paving_or_after_it_are_the_regions_of_the_summary(tmp_path, depth, extra,
+                                                                                          request):
     """Without --refine-to the regions' files are written while the joint cells are paved; with it the regions
     may be paved again afterwards, so everything is written after: either way the workspace paving on disk is the
-    one the summary describes, and every file listed exists."""
-    out = tmp_path / "run"
-    assert main(["analyze", "--depth", str(depth), "--out", str(out), "--quiet", *extra]) == 0
+    one the summary describes, and every file listed exists.  (Depth 4 without options is the run of
+    tests/conftest.py, shared with other files.)"""
+    if extra:
+        out = tmp_path / "run"
+        assert main(["analyze", "--depth", str(depth), "--out", str(out), "--quiet", *extra]) == 0
+    else:
+        out = request.getfixturevalue("analyze_depth4")
     s = json.loads((out / "summary.json").read_text())
     files = s["files"]
     assert len(files) == len(set(files)) and all((out / f).is_file() for f in files)
