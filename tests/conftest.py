@@ -57,13 +57,6 @@ def shared_root() -> Path | None:
     return _SHARED_ROOT[0]
 
 
-def built_once(tmp_path_factory, name: str, build):
-    """:func:`shared_value` for a session fixture (the fixture asks for ``tmp_path_factory`` so that the shared
-    folder is known)."""
-    _SHARED_ROOT[:] = [tmp_path_factory.getbasetemp().parent]
-    return shared_value(name, build)
-
-
 @pytest.fixture(scope="session")
 def paper_geometry():
     return default_geometry()
@@ -98,11 +91,11 @@ def small_chain(geometry, workspace_depth: int, joint_depth: int, regions_depth:
 
 
 @pytest.fixture(scope="session")
-def regions_chain(paper_geometry, tmp_path_factory):
+def regions_chain(paper_geometry):
     """The chain shared by space/test_basic_region.py, space/test_basic_region_properties.py and the depth-7
     test of space/test_trajectory.py (built once, about 8 s): workspace depth 7, joint grid 2**6, regions at
     depth 7.  Read only."""
-    return built_once(tmp_path_factory, "regions_chain", lambda: small_chain(paper_geometry, 7, 6, 7, max_solves=200))
+    return shared_value("regions_chain", lambda: small_chain(paper_geometry, 7, 6, 7, max_solves=200))
 
 
 @pytest.fixture(scope="session")
@@ -114,13 +107,13 @@ def aspect_topology(paper_geometry):
 
 
 @pytest.fixture(scope="session")
-def fold_paving(paper_geometry, tmp_path_factory):
+def fold_paving(paper_geometry):
     """The joint box paved directly with fold models and window models, depth 5 and one join level: the
     source of the ``joint_fold_model`` and ``joint_join`` claims in tests/certify and tests/checker (about
     30 s, read by 17 test files: built once a run)."""
     from intervalkin.space.joint_paving import pave_joint_space
 
-    return built_once(tmp_path_factory, "fold_paving",
+    return shared_value("fold_paving",
                       lambda: pave_joint_space(paper_geometry, 5, 1, fold=True, model_levels=1, windows=True))
 
 
@@ -134,13 +127,13 @@ def joint_paving_4(paper_geometry):
 
 
 @pytest.fixture(scope="session")
-def fold_models_5(paper_geometry, tmp_path_factory):
+def fold_models_5(paper_geometry):
     """The joint box paved at depth 5 with local models (one model level) and no joins: shared by
     solve/test_fold_model.py (its fold pieces), solve/test_local_model.py (its voided boxes) and
     checker/test_joint_claims.py (its clear groups joined only by fold pieces).  Read only."""
     from intervalkin.space.joint_paving import pave_joint_space
 
-    return built_once(tmp_path_factory, "fold_models_5",
+    return shared_value("fold_models_5",
                       lambda: pave_joint_space(paper_geometry, 5, join_levels=0, fold=True, model_levels=1))
 
 
