@@ -52,7 +52,7 @@ from intervalkin.solve.window_split import aligned_r_slopes
 from intervalkin.solve.window_model import DET_SIGN, WindowModels
 
 __all__ = ["AXIS_PAIRS", "CuspRetractions", "cusp_adds", "cusp_retractions", "cusp_windows", "cusp_direction_signs",
-           "cusp_retractions_where", "lifted_pair_signs"]
+           "cusp_retractions_where", "lifted_pair_signs", "window_hull"]
 
 #: Halvings of a cusp window's pieces before the slopes are read.
 HALVINGS = 0
@@ -184,7 +184,7 @@ def cusp_retractions_where(geometry: Geometry, models: WindowModels, rows: np.nd
     return dataclasses.replace(got, rows=rows, window=window, adds=cusp_adds(models, window), **ways)
 
 
-def _hull(value: Interval, owner: np.ndarray, keep: np.ndarray, m: int) -> Interval:
+def window_hull(value: Interval, owner: np.ndarray, keep: np.ndarray, m: int) -> Interval:
     """The hull per window of the pieces ``keep`` of ``value`` (empty windows: [inf, -inf])."""
     lo = np.full(m, np.inf)
     hi = np.full(m, -np.inf)
@@ -195,7 +195,7 @@ def _hull(value: Interval, owner: np.ndarray, keep: np.ndarray, m: int) -> Inter
 
 def _sign_over(value: Interval, owner: np.ndarray, keep: np.ndarray, m: int) -> np.ndarray:
     """(m,) the sign of ``value`` proved on every piece ``keep`` of each window (0: not proved, or no piece)."""
-    h = _hull(value, owner, keep, m)
+    h = window_hull(value, owner, keep, m)
     return np.where(h.lo > 0, 1, np.where(h.hi < 0, -1, 0)).astype(np.int64)
 
 
@@ -223,14 +223,14 @@ def _lifted_faces(f_r: list[Interval], f_phi_r: list[Interval], u: np.ndarray, v
     for side in (0, 1):
         at = root[side]
         sv = _sign_over(fv, owner, at, m)
-        q = _hull(fu / fv, owner, at, m)  # f_v may vanish on a piece only where sv = 0, and then d = 0
+        q = window_hull(fu / fv, owner, at, m)  # f_v may vanish on a piece only where sv = 0, and then d = 0
         q_lo[:, side], q_hi[:, side] = q.lo, q.hi
         if side == 1:  # d/dt f_phi at the middle root: J at one point of the window
             sk = _sign_over(gu * fv - gv * fu, owner, at, m)
         else:  # d/dt g(t) where f may vanish: f_phi,r between the root and t, the r-slopes at the root
             between = sets["between"]
-            k = (_hull(gu, owner, between, m) * _hull(fv, owner, at, m)
-                 - _hull(gv, owner, between, m) * _hull(fu, owner, at, m))
+            k = (window_hull(gu, owner, between, m) * window_hull(fv, owner, at, m)
+                 - window_hull(gv, owner, between, m) * window_hull(fu, owner, at, m))
             sk = np.where(k.lo > 0, 1, np.where(k.hi < 0, -1, 0))
         drive = e0 * sk * sv * (1 if side == 1 else -1)  # the sign d that keeps the side (0: none proved)
         moving = np.zeros(m, dtype=bool)

@@ -16,6 +16,7 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
+from intervalkin.solve.cusp_flow import inflection_flows
 from intervalkin.solve.fold_model import height_slopes
 from intervalkin.solve.window_cusp import (cusp_adds, cusp_direction_signs, cusp_retractions, cusp_retractions_where,
                                           cusp_windows, lifted_pair_signs)
@@ -274,12 +275,14 @@ def _cusp_nodes(geometry: Geometry, models, rows: np.ndarray, nodes: Nodes, leaf
     if crows.size:
         base = base_signature(models)
         lifted = cusp_retractions(geometry, models, crows)
+        flows = inflection_flows(geometry, models, crows)
         signs = cusp_direction_signs(geometry, models, crows, DIRECTIONS, workers)[lifted.window]
         for side, keeps in ((0, 1), (1, -1)):
             straight, direction = _direction_options((signs == keeps) | (signs == STEADY))
-            options = np.concatenate([lifted.faces[:, side], straight], axis=1)
-            directions = np.concatenate([np.zeros(lifted.faces.shape[:1] + lifted.faces.shape[2:3] + (3,)), direction],
-                                        axis=1)  # lifted paths have no direction: they are not segments
+            options = np.concatenate([lifted.faces[:, side], flows[:, side], straight], axis=1)
+            curved = lifted.faces.shape[2] + flows.shape[2]
+            # lifted paths and inflection flows have no direction: they are not segments
+            directions = np.concatenate([np.zeros((crows.size, curved, 3)), direction], axis=1)
             nodes.add(leaf_of_row[crows], base[crows] + lifted.adds[:, side], RET, 4, -1, options, directions)
     return crows
 
