@@ -59,8 +59,8 @@ __all__ = ["inflection_flows", "FLOW_AXES"]
 
 #: The axis j held still by each flow (V_j = 0), one way per axis.
 FLOW_AXES = (0, 1, 2)
-#: Halvings of the window's pieces before the gradients at the inflection are enclosed (on the paper's depth-5
-#: paving the 2 x 2 determinant is signed on 2 of 953 cusp leaves with none, about 220 with two, no more with four).
+#: Halvings of the inflection's run of pieces before the gradients there are enclosed (on the default paving's 9297
+#: leaves with one cusp window: 1079 flows with none, 1084 with one, 1086 with two and with three).
 HALVINGS = 2
 
 
