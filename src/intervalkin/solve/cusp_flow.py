@@ -33,6 +33,14 @@ The flow leaves R through a face when one of V_i, V_k has a proved sign (then |V
 that coordinate is monotone); a coordinate whose sign is not proved may reach either of its faces, and
 r_j = rho_j^2 stays.  So each side gets the faces its points may reach, for each choice of j.
 
+As a way of a cusp pattern.  Where V_i has a proved sign s_i, +V = |V_i| s_i (e_i - q e_k) with
+q = -V_k / V_i = a_i / a_k (det cancels), so the flow moves r with velocity d (u - q v), u = e_i, v = e_k, q in
+the hull of a_i / a_k, d = s_i on the three-root side and -s_i on the one-root side (with i and k exchanged where
+only V_k is signed): the form of a lifted path (:func:`~intervalkin.solve.window_cusp.lifted_pair_signs`), so
+a pair window keeps its status along the flow when s (D_u f - q D_v f) has the sign that keeps it on the
+window's critical pieces for every such q (proofs/lemma-joint-retraction.md, "Cusp patterns: the inflection
+flow").
+
 The enclosures.  psi lies in the run Psi of pieces between the first and the last where g'' may vanish (halved
 twice).  With psi0 its centre, a(psi) = a(psi0) + (psi - psi0) mean(b) (the mean of b over [psi0, psi], in the hull
 B of b over Psi, entry by entry), so
@@ -47,6 +55,8 @@ the mean-value form over pieces), so the true V(r) lies in the enclosure of the 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from intervalkin.core.geometry import Geometry
@@ -55,7 +65,7 @@ from intervalkin.solve.simple_roots import ReducedBoxes
 from intervalkin.solve.window_cusp import cusp_windows, window_hull
 from intervalkin.solve.window_model import WindowModels
 
-__all__ = ["inflection_flows", "FLOW_AXES"]
+__all__ = ["InflectionFlows", "flow_ways", "inflection_flows", "FLOW_AXES"]
 
 #: The axis j held still by each flow (V_j = 0), one way per axis.
 FLOW_AXES = (0, 1, 2)
@@ -64,21 +74,50 @@ FLOW_AXES = (0, 1, 2)
 HALVINGS = 2
 
 
+@dataclass(frozen=True, eq=False)
+class InflectionFlows:
+    """The inflection flows of boxes with one cusp window, one way per held axis j of :data:`FLOW_AXES`.
+
+    faces : (m, 2, 3, 6) bool, for each side (0 one root, along -V; 1 three roots, along +V) and way, the faces
+        (2 axis + 0 low, + 1 high) the side's points may reach (all False where the flow is not proved).
+    drive : (m, 2, 3) int8, d: along the side's flow r moves with velocity d (u - q v) times a positive factor
+        (0 where the flow is not proved).
+    drive_u, follow_v : (m, 3, 3) the vectors u and v of each way (unit vectors of r = rho^2).
+    follow_lo, follow_hi : (m, 3) an enclosure of q over the box (module docstring); lo > hi where not proved.
+    """
+
+    faces: np.ndarray
+    drive: np.ndarray
+    drive_u: np.ndarray
+    follow_v: np.ndarray
+    follow_lo: np.ndarray
+    follow_hi: np.ndarray
+
+
 def inflection_flows(geometry: Geometry, models: WindowModels, rows: np.ndarray, halvings: int = HALVINGS) -> np.ndarray:
-    """(m, 2, 3, 6) bool for boxes ``rows`` (m,), each with exactly one cusp window: for each side (0 one root,
-    along -V; 1 three roots, along +V) and each held axis j of :data:`FLOW_AXES`, the faces (2 axis + 0 low,
-    + 1 high) the side's points may reach along the inflection flow (module docstring); all False where the flow
-    is not proved (the window's f''' not signed, the inflection not forced into the window, det A of the 2 x 2
-    system not signed, K W >= 2, or no moving coordinate proved monotone).  The window's pieces are halved
-    ``halvings`` times for the enclosures at the inflection."""
+    """(m, 2, 3, 6) bool for boxes ``rows`` (m,), each with exactly one cusp window: the faces of
+    :func:`flow_ways`."""
+    return flow_ways(geometry, models, rows, halvings).faces
+
+
+def flow_ways(geometry: Geometry, models: WindowModels, rows: np.ndarray, halvings: int = HALVINGS) -> InflectionFlows:
+    """The inflection flows of boxes ``rows`` (m,), each with exactly one cusp window (:class:`InflectionFlows`,
+    module docstring).  A flow is not proved where the window's f''' is not signed, the inflection is not forced
+    into the window, det A of the 2 x 2 system is not signed, K W >= 2, or no moving coordinate is proved
+    monotone.  The window's pieces are halved ``halvings`` times for the enclosures at the inflection."""
     rows = np.asarray(rows, dtype=np.int64)
     m = rows.size
-    faces = np.zeros((m, 2, len(FLOW_AXES), 6), dtype=bool)
+    ways = len(FLOW_AXES)
+    faces = np.zeros((m, 2, ways, 6), dtype=bool)
+    drive = np.zeros((m, 2, ways), dtype=np.int8)
+    drive_u, follow_v = np.zeros((m, ways, 3)), np.zeros((m, ways, 3))
+    follow_lo, follow_hi = np.ones((m, ways)), np.zeros((m, ways))
+    result = InflectionFlows(faces, drive, drive_u, follow_v, follow_lo, follow_hi)
     window = np.flatnonzero(cusp_windows(models) & np.isin(models.window_box, rows))
     if window.size != m or not np.array_equal(models.window_box[window], rows):
         raise ValueError("inflection_flows: each row needs exactly one cusp window")
     if not m:
-        return faces
+        return result
     on = np.isin(models.piece_window, window)
     pw, lo, hi = models.piece_window[on], models.piece_lo[on], models.piece_hi[on]
     slot = np.full(len(models.degree), -1, dtype=np.int64)
@@ -153,4 +192,14 @@ def inflection_flows(geometry: Geometry, models: WindowModels, rows: np.ndarray,
             for axis, sv in ((i, si), (k, sk)):
                 faces[:, side, way, 2 * axis] = good & (toward * sv <= 0)
                 faces[:, side, way, 2 * axis + 1] = good & (toward * sv >= 0)
-    return faces
+        # the way as d (u - q v): u along a coordinate whose V entry is signed, q = a_u / a_v (det cancels)
+        by_i = good & (si != 0)
+        by_k = good & (si == 0)
+        with np.errstate(all="ignore"):
+            q_i, q_k = a[i] / a[k], a[k] / a[i]
+        for sel, (ua, va), q, sv in ((by_i, (i, k), q_i, si), (by_k, (k, i), q_k, sk)):
+            drive_u[sel, way, ua] = 1.0
+            follow_v[sel, way, va] = 1.0
+            follow_lo[sel, way], follow_hi[sel, way] = q.lo[sel], q.hi[sel]
+            drive[sel, 1, way], drive[sel, 0, way] = sv[sel], -sv[sel]
+    return result

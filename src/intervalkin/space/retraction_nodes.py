@@ -16,13 +16,14 @@ import numpy as np
 
 from intervalkin.core.geometry import Geometry
 from intervalkin.core.workers import Workers
-from intervalkin.solve.cusp_flow import inflection_flows
+from intervalkin.solve.cusp_flow import flow_ways, inflection_flows
 from intervalkin.solve.fold_model import height_slopes
 from intervalkin.solve.window_cusp import (cusp_adds, cusp_direction_signs, cusp_retractions, cusp_retractions_where,
                                           cusp_windows, lifted_pair_signs)
 from intervalkin.solve.window_fold import (CLEAR, FOLD, PAIR, STEADY, base_signature, pair_direction_signs,
                                           pair_windows, window_kinds)
 from intervalkin.solve.window_model import DET_SIGN
+from intervalkin.solve.window_patterns import curved_keeps, pattern_keeps, patterns
 from intervalkin.solve.window_plane import split_at_zeros_of_d
 from intervalkin.solve.window_union import joined_windows
 from intervalkin.space.retraction_ranks import LEFT, RET, SINK
@@ -236,8 +237,8 @@ def window_nodes(jp, geometry: Geometry, nodes: Nodes, workers: Workers | None =
             if not rk.size:
                 continue
             wins = np.flatnonzero(live & np.isin(box, rk)).reshape(rk.size, k)  # windows are sorted by box
-            for real in _patterns(k):
-                keeps = _pattern_keeps(signs[wins], real)
+            for real in patterns(k):
+                keeps = pattern_keeps(signs[wins], real)
                 at = _within_rolle(split, constant, wins, real)
                 nodes.add(win.leaf[rk[at]], base[rk[at]] + int(real.sum()) * PAIR, RET, 3, -1,
                           *_direction_options(keeps[at]), plane=(split, rk[at]))
@@ -287,18 +288,6 @@ def _cusp_nodes(geometry: Geometry, models, rows: np.ndarray, nodes: Nodes, leaf
     return crows
 
 
-def _patterns(k: int):
-    """The 2**k patterns of k pair windows: (k,) int64, 1 where the window holds its two roots."""
-    for pattern in range(1 << k):
-        yield np.array([(pattern >> i) & 1 for i in range(k)], dtype=np.int64)
-
-
-def _pattern_keeps(signs: np.ndarray, real: np.ndarray) -> np.ndarray:
-    """(m, c) bool from the signs (m, k, c) of the pattern's k windows: the directions along which no u_i falls where
-    window i is empty and none rises where it holds its two roots (or the window is STEADY)."""
-    return ((signs * (1 - 2 * real)[None, :, None] == 1) | (signs == STEADY)).all(axis=1)
-
-
 def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, live: np.ndarray, pair_signs: np.ndarray,
                         nodes: Nodes, leaf_of_row: np.ndarray, workers: Workers | None = None) -> np.ndarray:
     """The nodes of the rows (m,) with one cusp window, pair windows and windows of fixed count: one per pattern of
@@ -312,8 +301,10 @@ def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, liv
     the cusp window (:func:`~intervalkin.solve.window_cusp.cusp_retractions`) keeps the node when it also keeps each
     pair window's pattern: r moves with velocity d (u - q v), and s D_u f - q s D_v f is signed on the window's
     critical pieces for every q of the way (:func:`~intervalkin.solve.window_cusp.lifted_pair_signs`); a side
-    proved empty keeps its (empty) node along any face.  Not where a plane cuts the leaf (``Nodes.add`` drops the
-    ways without a direction there: they may cross it)."""
+    proved empty keeps its (empty) node along any face.  The inflection flow of the cusp window
+    (:func:`~intervalkin.solve.cusp_flow.flow_ways`) has the same form, r' = |V_i| d (u - q v), so it keeps the node
+    on the same terms (lemma "Cusp patterns: the inflection flow").  Curved ways are not used where a plane cuts
+    the leaf: they may cross it."""
     box, n = models.window_box, len(models.ok)
     n_live = np.bincount(box, weights=live, minlength=n)
     rows = rows[n_live[rows] <= MAX_PAIR_WINDOWS]
@@ -331,24 +322,29 @@ def _cusp_pattern_nodes(geometry: Geometry, models, split, rows: np.ndarray, liv
     way_signs = lifted_pair_signs(geometry, models, rows, np.concatenate([lifted.drive_u] * 2, axis=1),
                                   np.concatenate([lifted.follow_v] * 2, axis=1), lifted.follow_lo.reshape(rows.size, -1),
                                   lifted.follow_hi.reshape(rows.size, -1), PAIR_HALVINGS)
+    uncut = split.plane[rows] == 0
+    flows = flow_ways(geometry, models, rows)  # both sides share u, v and q; only the drive's sign differs
+    go = flows.drive.any(axis=(1, 2)) & uncut
+    flow_signs = lifted_pair_signs(geometry, models, rows[go], flows.drive_u[go], flows.follow_v[go],
+                                   flows.follow_lo[go], flows.follow_hi[go], PAIR_HALVINGS)
     for k in range(MAX_PAIR_WINDOWS + 1):  # k = 0: every pair window free of roots, the cusp window alone
         pick = np.flatnonzero(n_live[rows] == k)
         if not pick.size:
             continue
         rk = rows[pick]
         wins = np.flatnonzero(live & np.isin(box, rk)).reshape(rk.size, k)
-        for real in _patterns(k):
-            keeps = _pattern_keeps(pair_signs[wins], real)
+        for real in patterns(k):
+            keeps = pattern_keeps(pair_signs[wins], real)
             at = _within_rolle(split, constant, wins, real)
             for side, want in ((0, 1), (1, -1)):
                 both = keeps & ((side_signs[pick] == want) | (side_signs[pick] == STEADY))
                 straight, direction = _direction_options(both[at])
-                drive = lifted.drive[pick[at], side].astype(np.int64)  # (m, ways)
-                along = drive[:, None, :] * way_signs[wins[at]][:, :, side * ways:(side + 1) * ways]
                 steady = (pair_signs[wins[at]][:, :, :1] == STEADY)
-                kept = _pattern_keeps(np.where(steady, STEADY, along), real) | (drive == 0)
-                options = np.concatenate([straight, lifted.faces[pick[at], side] & kept[..., None]], axis=1)
-                directions = np.concatenate([direction, np.zeros(kept.shape + (3,))], axis=1)
+                faces = [w.faces[pick[at], side] & uncut[pick[at], None, None] for w in (lifted, flows)]
+                curved = [curved_keeps(w.drive[pick[at], side], s[wins[at]], f, steady, real) for w, s, f
+                          in zip((lifted, flows), (way_signs[:, side * ways:(side + 1) * ways], flow_signs), faces)]
+                options = np.concatenate([straight] + curved, axis=1)
+                directions = np.concatenate([direction, np.zeros((len(options), sum(c.shape[1] for c in curved), 3))], axis=1)
                 nodes.add(leaf_of_row[rk[at]], base[rk[at]] + int(real.sum()) * PAIR + adds[pick[at], side], RET, 7,
                           -1, options, directions, plane=(split, rk[at]))
     return rows
