@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from intervalkin.solve.cusp_flow import FLOW_AXES, inflection_flows
+from intervalkin.solve.cusp_flow import FLOW_AXES, flow_ways, inflection_flows
 from intervalkin.solve.dkp import solve
 from intervalkin.solve.simple_roots import ReducedBoxes
-from intervalkin.solve.window_cusp import cusp_windows
-from intervalkin.solve.window_fold import window_kinds
+from intervalkin.solve.window_cusp import cusp_windows, lifted_pair_signs
+from intervalkin.solve.window_fold import pair_windows, window_kinds
 from intervalkin.solve.window_model import window_models
 from intervalkin.solve.window_plane import split_at_zeros_of_d
 from intervalkin.solve.window_union import joined_windows
@@ -52,7 +52,7 @@ def _field(geometry, r: np.ndarray, wa: float, wb: float, j: int) -> np.ndarray 
     a_, b_ = wa, wb
     if not (s3 * d(2, a_) < 0 < s3 * d(2, b_)):
         return None
-    for _ in range(60):
+    for _ in range(40):  # the window is under 1 rad wide: psi to 1e-12
         c = 0.5 * a_ + 0.5 * b_
         a_, b_ = (c, b_) if s3 * d(2, c) < 0 else (a_, c)
     psi = np.array([0.5 * a_ + 0.5 * b_])
@@ -65,12 +65,19 @@ def _field(geometry, r: np.ndarray, wa: float, wb: float, j: int) -> np.ndarray 
     return v
 
 
-def _in_window(geometry, rho: np.ndarray, wa: float, wb: float) -> int | None:
-    """The number of solutions with phi in [wa, wb], from an independent certified solve (None: not complete)."""
+def _in_windows(geometry, rho: np.ndarray, arcs) -> list[int] | None:
+    """The number of solutions with phi in each [wa, wb] of ``arcs``, from one independent certified solve (None:
+    not complete)."""
     res = solve(geometry, [Fraction(float(x)) for x in rho])
     if not res.complete or any(s.status != "unique" for s in res.solutions):
         return None
-    return sum(wa <= float(s.box[2].mean()) <= wb for s in res.solutions)
+    return [sum(wa <= float(s.box[2].mean()) <= wb for s in res.solutions) for wa, wb in arcs]
+
+
+def _in_window(geometry, rho: np.ndarray, wa: float, wb: float) -> int | None:
+    """The number of solutions with phi in [wa, wb] (:func:`_in_windows`)."""
+    got = _in_windows(geometry, rho, [(wa, wb)])
+    return None if got is None else got[0]
 
 
 def test_flows_are_found_near_the_cusp_edges(flows):
@@ -129,3 +136,134 @@ def test_the_flow_keeps_the_count_of_the_window_up_to_a_face(flows, paper_geomet
         assert left is not None and faces[n, side, way, left], (row, side, way, left)
         done += 1
     assert done >= 5
+
+
+@pytest.fixture(scope="module")
+def ways(flows, paper_geometry):
+    """The same rows' flows in the form of a lifted path (:func:`flow_ways`)."""
+    children, crow, _ = flows
+    return flow_ways(paper_geometry, children, crow)
+
+
+def test_flow_ways_carry_the_faces_and_a_drive_where_proved(flows, ways):
+    """The faces of :func:`flow_ways` are :func:`inflection_flows`'; a way has a drive exactly where it has faces,
+    the same u and v on both sides, opposite drives (+V on the three-root side, -V on the one-root side), u and v
+    unit vectors of two axes other than the held one, and a nonempty hull of q."""
+    _, _, faces = flows
+    assert np.array_equal(ways.faces, faces)
+    driven = ways.drive[:, 1] != 0
+    assert np.array_equal(driven, faces[:, 1].any(axis=2)) and np.array_equal(ways.drive[:, 0], -ways.drive[:, 1])
+    assert driven.sum() >= 30
+    for way, j in enumerate(FLOW_AXES):
+        on = driven[:, way]
+        u, v = ways.drive_u[on, way], ways.follow_v[on, way]
+        assert np.all(u.sum(axis=1) == 1) and np.all(v.sum(axis=1) == 1) and np.all((u * v).sum(axis=1) == 0)
+        assert not u[:, j].any() and not v[:, j].any()
+        assert np.all(ways.follow_lo[on, way] <= ways.follow_hi[on, way])
+        assert np.all(ways.follow_lo[~on, way] > ways.follow_hi[~on, way])
+
+
+def test_the_field_is_the_drive_along_u_minus_q_v(flows, ways, paper_geometry):
+    """Property test (proofs/lemma-joint-retraction.md, "Cusp patterns: the inflection flow"): at points sampled
+    in a box with a driven way, the field V of the held axis (followed in floats, :func:`_field`) is a positive
+    multiple of drive (u - q v) on the three-root side, q = -V.v / V.u in the way's hull [follow_lo, follow_hi]:
+    the velocity set handed to the pair windows' signs holds the flow's velocity.  A drive of the wrong sign, or a
+    hull of a_k / a_i for a_i / a_k, fails."""
+    children, crow, _ = flows
+    rng = np.random.default_rng(23)
+    checked = 0
+    for n, way in zip(*np.nonzero(ways.drive[:, 1])):
+        if checked >= 120:
+            break
+        row = crow[n]
+        box = children.boxes[row]
+        window = np.flatnonzero((children.window_box == row) & cusp_windows(children))[0]
+        on = children.piece_window == window
+        wa, wb = children.piece_lo[on][0], children.piece_hi[on][-1]
+        if wa >= wb:
+            continue
+        u, v = ways.drive_u[n, way], ways.follow_v[n, way]
+        lo, hi = ways.follow_lo[n, way], ways.follow_hi[n, way]
+        for _ in range(3):
+            rho = box[:, 0] + rng.random(3) * (box[:, 1] - box[:, 0])
+            field = _field(paper_geometry, rho**2, wa, wb, FLOW_AXES[way])
+            if field is None:
+                continue
+            assert np.sign(field @ u) == ways.drive[n, 1, way], (row, way, rho, field)
+            q = -(field @ v) / (field @ u)
+            slack = 1e-9 * max(1.0, abs(q))
+            assert lo - slack <= q <= hi + slack, (row, way, rho, q, lo, hi)
+            checked += 1
+    assert checked >= 60, checked
+
+
+@pytest.fixture(scope="module")
+def beside_pairs(paper_geometry):
+    """Leaves of the default paving with one cusp window and pair windows beside it
+    (``tests/data/cusp_pattern_flow_leaves.json``: boxes only), modelled again as the retraction reads them; the
+    rows with no plane and windows of fixed count otherwise, their flows and the pair windows' signs along them."""
+    boxes = np.array(json.loads((Path(__file__).parents[1] / "data" / "cusp_pattern_flow_leaves.json").read_text())["boxes"])
+    split = split_at_zeros_of_d(paper_geometry, joined_windows(window_models(paper_geometry, boxes)))
+    models = split.models
+    cusp, pair, n = cusp_windows(models), pair_windows(models), len(models.ok)
+    count = lambda w: np.bincount(models.window_box, weights=w, minlength=n)  # noqa: E731
+    fixed = count(~pair & ~cusp & ~window_kinds(models)[3]) == 0
+    rows = np.flatnonzero(models.ok & (count(cusp) == 1) & (count(pair) >= 1) & fixed & (split.plane == 0))
+    ways = flow_ways(paper_geometry, models, rows)
+    signs = lifted_pair_signs(paper_geometry, models, rows, ways.drive_u, ways.follow_v, ways.follow_lo,
+                              ways.follow_hi, 1)
+    return models, rows, ways, signs
+
+
+def _arc(models, window: int) -> tuple[float, float]:
+    on = models.piece_window == window
+    return float(models.piece_lo[on][0]), float(models.piece_hi[on][-1])
+
+
+def test_the_flow_keeps_the_pair_windows_it_signs(beside_pairs, paper_geometry):
+    """Property test of the cusp patterns' curved way (lemma "Cusp patterns: the inflection flow"): from points of
+    a side of the cusp window (counts by certified solves), follow V (three roots) or -V (one root); a pair window
+    whose roots' minimum moves with d sigma = +1 (sigma its proved sign along the way, d the drive) stays empty
+    when it starts empty, one with d sigma = -1 keeps its two roots when it starts with them, at every point
+    checked up to the exit.  Cases where the status would be kept anyway are counted apart; the test needs paths
+    on which a sign was actually relied on."""
+    models, rows, ways, signs = beside_pairs
+    assert rows.size >= 15 and ways.drive.any(axis=(1, 2)).sum() >= 15
+    rng = np.random.default_rng(29)
+    relied, paths = 0, 0
+    for n, way in zip(*np.nonzero(ways.drive[:, 1])):
+        if paths >= 12:
+            break
+        row = rows[n]
+        box = models.boxes[row]
+        cw = np.flatnonzero((models.window_box == row) & cusp_windows(models))[0]
+        wa, wb = _arc(models, cw)
+        held = [w for w in np.flatnonzero((models.window_box == row) & (signs[:, way] != 0)) if np.less(*_arc(models, w))]
+        if wa >= wb or not held:
+            continue
+        for _ in range(3):
+            x = box[:, 0] + rng.random(3) * (box[:, 1] - box[:, 0])
+            got = _in_windows(paper_geometry, x, [(wa, wb)] + [_arc(models, w) for w in held])
+            if got is None or got[0] not in (1, 3):
+                continue
+            side = int(got[0] == 3)
+            d = int(ways.drive[n, side, way])
+            start = dict(zip(held, got[1:]))
+            # the windows the sign keeps: empty ones whose minimum rises, full ones whose minimum falls
+            kept = [w for w in held if d * signs[w, way] == (1 if start[w] == 0 else -1)]
+            if not kept:
+                continue
+            r, step = x**2, 0.02 * float(np.min(box[:, 1] ** 2 - box[:, 0] ** 2))
+            for k in range(1, 300):
+                v = _field(paper_geometry, r, wa, wb, FLOW_AXES[way])
+                assert v is not None, (row, side, way, np.sqrt(r))
+                r = r + (1.0 if side else -1.0) * step * v / np.linalg.norm(v)
+                rho = np.sqrt(r)
+                if np.any((rho < box[:, 0]) | (rho > box[:, 1])):
+                    break
+                if k % 4 == 0:
+                    now = _in_windows(paper_geometry, rho, [_arc(models, w) for w in kept])
+                    assert now is None or now == [start[w] for w in kept], (row, side, way, kept, rho, now)
+            relied += len(kept)
+            paths += 1
+    assert paths >= 10 and relied >= 12, (paths, relied)
