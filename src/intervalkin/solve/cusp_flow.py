@@ -22,7 +22,11 @@ dm/dt = h(c2), h(phi) = grad_r g(phi; r) . V.  As h(psi) = 0 and h'(psi) = -1, T
     h(c) = (psi - c) (1 + h''(xi) (psi - c) / 2),    xi between psi and c,
 
 so with |h''| <= K over the window and the box (h'' = grad_r g'' . V) and W the window's length, K W < 2
-makes h(c1) > 0 > h(c2): M rises and m falls along +V, which keeps the three-root side (M > 0 > m stay; a
+makes h(c1) > 0 > h(c2).  Closer: at every r of the box c1 and c2 lie in the pieces P where g' may vanish and
+psi in the run Psi (below), so c1 in [min P, psi] and c2 in [psi, max P]; with K_L, K_R the bounds of |h''| on
+the pieces meeting [min P, max Psi] and [min Psi, max P], K_L (max Psi - min P) < 2 and K_R (max P - min Psi) < 2
+suffice (a side without a piece of P has no critical point to bound; a window across phi = pi keeps K W).  Near
+the cusp edge c1, c2 and psi come together, so these distances are far below W.  Then M rises and m falls along +V, which keeps the three-root side (M > 0 > m stay; a
 critical point cannot leave the window, where g(w_a) < 0 < g(w_b)); along -V, M falls and m rises and alpha
 rises, which keeps the one-root side (M < 0 stays, or m > 0 stays; when c1 and c2 merge g becomes monotone;
 if one of them leaves the window the value left inside has the sign of the end it left by).  This is the
@@ -72,6 +76,8 @@ FLOW_AXES = (0, 1, 2)
 #: Halvings of the inflection's run of pieces before the gradients there are enclosed (on the default paving's 9297
 #: leaves with one cusp window: 1079 flows with none, 1084 with one, 1086 with two and with three).
 HALVINGS = 2
+#: Halvings of the window's pieces when finding where g' may vanish (the critical points' pieces).
+CRITICAL_HALVINGS = 2
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,11 +106,14 @@ def inflection_flows(geometry: Geometry, models: WindowModels, rows: np.ndarray,
     return flow_ways(geometry, models, rows, halvings).faces
 
 
-def flow_ways(geometry: Geometry, models: WindowModels, rows: np.ndarray, halvings: int = HALVINGS) -> InflectionFlows:
+def flow_ways(geometry: Geometry, models: WindowModels, rows: np.ndarray, halvings: int = HALVINGS,
+              near_critical: bool = True) -> InflectionFlows:
     """The inflection flows of boxes ``rows`` (m,), each with exactly one cusp window (:class:`InflectionFlows`,
     module docstring).  A flow is not proved where the window's f''' is not signed, the inflection is not forced
     into the window, det A of the 2 x 2 system is not signed, K W >= 2, or no moving coordinate is proved
-    monotone.  The window's pieces are halved ``halvings`` times for the enclosures at the inflection."""
+    monotone.  The window's pieces are halved ``halvings`` times for the enclosures at the inflection.
+    ``near_critical``: bound h'' only between the inflection's run and the pieces where g' may vanish (module
+    docstring); False keeps the bound over the whole window's length W (the weaker test, for comparison)."""
     rows = np.asarray(rows, dtype=np.int64)
     m = rows.size
     ways = len(FLOW_AXES)
@@ -144,10 +153,22 @@ def flow_ways(geometry: Geometry, models: WindowModels, rows: np.ndarray, halvin
     # one, g' would need two changes of sign from - to + to -, which a convex g' cannot make)
     rising = s3 * models.end_signs[window, 0] < 0
     forced = rising & (models.degree[window] == 3) & (g2_a.hi < 0) & (g2_b.lo > 0)
-    # h'' = grad_r g'' . V needs grad_r g'' over the whole window
+    # h'' = grad_r g'' . V, per piece of the window (its hulls bound h'' between psi and a critical point)
     sp = s3[owner]
-    c = [window_hull(data.r_slope(owner, lo, hi, i, 2, mean_value=True) * sp, owner, np.ones(owner.size, dtype=bool), m)
-         for i in range(3)]
+    wo, wlo, whi = owner, lo, hi
+    c_piece = [data.r_slope(owner, lo, hi, i, 2, mean_value=True) * sp for i in range(3)]
+    c = [window_hull(ci, owner, np.ones(owner.size, dtype=bool), m) for ci in c_piece]
+    # the critical points c1 < c2 lie, at every r of the box, where g' may vanish (halved CRITICAL_HALVINGS times)
+    crit_lo, crit_hi = np.full(m, np.inf), np.full(m, -np.inf)
+    co, clo, chi = owner, lo, hi
+    for round_ in range(CRITICAL_HALVINGS + 1):
+        if round_:
+            mid = np.minimum(np.maximum(0.5 * clo + 0.5 * chi, clo), chi)
+            co, clo, chi = np.r_[co, co], np.r_[clo, mid], np.r_[mid, chi]
+        crit = sign_label(data.enclosure(co, clo, chi, 1)) == 0
+        co, clo, chi = co[crit], clo[crit], chi[crit]
+    np.minimum.at(crit_lo, co, clo)
+    np.maximum.at(crit_hi, co, chi)
     # the run of pieces that holds the inflection (between the first and the last where g'' may vanish), halved:
     # grad_r g turns with phi at the rate grad_r g', which a wide run spreads over its hull
     keep = np.ones(owner.size, dtype=bool)
@@ -175,6 +196,18 @@ def flow_ways(geometry: Geometry, models: WindowModels, rows: np.ndarray, halvin
     # b(psi) - mean(b) per entry: grad_r g'' over the run times at most |psi - psi0|
     e = [Interval(-x, x) for x in (round_up(reach * np.maximum(np.abs(ci.lo), np.abs(ci.hi))) for ci in c_psi)]
     base = forced & near
+    # c1 sits in [crit_lo, psi], c2 in [psi, crit_hi]: the Taylor bound needs h'' there only, over those distances
+    # (a window across phi = pi keeps the bound over its whole length W)
+    flat = wlo[first] < whi[last]
+    left_at = (whi >= crit_lo[wo]) & (wlo <= span.hi[wo])
+    right_at = (wlo <= crit_hi[wo]) & (whi >= span.lo[wo])
+    c_left = [window_hull(ci, wo, left_at, m) for ci in c_piece]
+    c_right = [window_hull(ci, wo, right_at, m) for ci in c_piece]
+    # (float comparisons are exact: a side is vacuous when no piece of P reaches the run)
+    none_left, none_right = ~(crit_lo < span.hi), ~(crit_hi > span.lo)
+    with np.errstate(invalid="ignore"):
+        d_left = np.where(none_left, 0.0, round_up(span.hi - crit_lo))
+        d_right = np.where(none_right, 0.0, round_up(crit_hi - span.lo))
     for way, j in enumerate(FLOW_AXES):
         i, k = [x for x in range(3) if x != j]
         # det(a(psi), b(psi)) = det(a(psi0), b(psi)) + (psi - psi0) det(mean(b), b(psi) - mean(b))
@@ -186,6 +219,13 @@ def flow_ways(geometry: Geometry, models: WindowModels, rows: np.ndarray, halvin
             curve = c[i] * vi + c[k] * vk  # h'' = grad_r g'' . V over the window and the box
             bound = np.maximum(np.abs(curve.lo), np.abs(curve.hi))
             small = round_up(bound * length) < 2.0
+            sides = []
+            for ch, dist, none in ((c_left, d_left, none_left), (c_right, d_right, none_right)):
+                part = ch[i] * vi + ch[k] * vk
+                b_side = np.maximum(np.abs(part.lo), np.abs(part.hi))
+                # no critical piece on this side: c1 (c2) is never in the window there, nothing to bound
+                sides.append(none | (np.isfinite(b_side) & (round_up(b_side * dist) < 2.0)))
+            small = np.where(near_critical & flat & np.isfinite(bound), sides[0] & sides[1], small)
         si, sk = sign_label(vi), sign_label(vk)
         good = signed & small & np.isfinite(bound) & ((si != 0) | (sk != 0))
         for side, toward in ((1, 1), (0, -1)):
