@@ -118,9 +118,7 @@ def _follow_flows(geometry, children, crow, faces, rng, most: int) -> int:
             break
         row = crow[n]
         box = children.boxes[row]
-        window = np.flatnonzero((children.window_box == row) & cusp_windows(children))[0]
-        on = children.piece_window == window
-        wa, wb = children.piece_lo[on][0], children.piece_hi[on][-1]
+        wa, wb = _arc(children, _cusp_window(children, row))
         if wa >= wb:
             continue  # a window across phi = pi: skipped here
         want = 3 if side else 1
@@ -193,9 +191,7 @@ def test_the_field_is_the_drive_along_u_minus_q_v(flows, ways, paper_geometry):
             break
         row = crow[n]
         box = children.boxes[row]
-        window = np.flatnonzero((children.window_box == row) & cusp_windows(children))[0]
-        on = children.piece_window == window
-        wa, wb = children.piece_lo[on][0], children.piece_hi[on][-1]
+        wa, wb = _arc(children, _cusp_window(children, row))
         if wa >= wb:
             continue
         u, v = ways.drive_u[n, way], ways.follow_v[n, way]
@@ -231,6 +227,10 @@ def beside_pairs(paper_geometry):
     return models, rows, ways, signs
 
 
+def _cusp_window(models, row: int) -> int:
+    return int(np.flatnonzero((models.window_box == row) & cusp_windows(models))[0])
+
+
 def _arc(models, window: int) -> tuple[float, float]:
     on = models.piece_window == window
     return float(models.piece_lo[on][0]), float(models.piece_hi[on][-1])
@@ -252,8 +252,7 @@ def test_the_flow_keeps_the_pair_windows_it_signs(beside_pairs, paper_geometry):
             break
         row = rows[n]
         box = models.boxes[row]
-        cw = np.flatnonzero((models.window_box == row) & cusp_windows(models))[0]
-        wa, wb = _arc(models, cw)
+        wa, wb = _arc(models, _cusp_window(models, row))
         held = [w for w in np.flatnonzero((models.window_box == row) & (signs[:, way] != 0)) if np.less(*_arc(models, w))]
         if wa >= wb or not held:
             continue
