@@ -14,7 +14,7 @@ from flint import arb, ctx
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from intervalkin.core.interval import PI_HI, PI_LO, TRIG_ABS_ERROR, Interval, sign_label
+from intervalkin.core.interval import PI_HI, PI_LO, TRIG_ABS_ERROR, Interval, integer_combinations, sign_label
 from intervalkin.core.exact import arb_to_bounds, fraction_bounds
 
 finite = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False, allow_infinity=False)
@@ -160,6 +160,45 @@ def test_vectorized_shapes_and_sign_label():
     a = Interval.from_bounds([-2.0, 1.0, -1.0], [-1.0, 2.0, 1.0])
     assert list(sign_label(a)) == [-1, 1, 0]
     assert (a * a).shape == (3,)
+
+
+def test_sign_label_reads_an_empty_interval_as_its_lower_end_and_keeps_0_d_arrays():
+    """lo > 0 wins where hi < 0 holds too (an empty [lo, hi] reads +1), NaN reads 0, and a 0-d input stays an
+    array: what callers relied on before the label was computed from the booleans' bytes."""
+    got = sign_label(Interval.from_bounds([3.0, -3.0, np.nan, 0.0], [-1.0, -1.0, np.nan, 0.0]))
+    assert got.dtype == np.int8 and got.tolist() == [1, -1, 0, 0]
+    zero_d = sign_label(Interval(1.0, 2.0))
+    assert isinstance(zero_d, np.ndarray) and zero_d.shape == () and int(zero_d) == 1
+    assert sign_label(Interval(np.zeros((2, 1)) - 1.0, -np.ones((1, 3)))).shape == (2, 3)
+
+
+#: Magnitudes from tiny to past 2**1000, where integer_combinations checks its ends for overflow.
+_SPREAD = st.floats(min_value=-1e305, max_value=1e305, allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(_SPREAD, _SPREAD, unit), min_size=3, max_size=3),
+       st.lists(st.lists(st.integers(-2, 2), min_size=3, max_size=3), min_size=1, max_size=6))
+def test_integer_combinations_contain_the_exact_sums(ends, rows):
+    lo = np.array([[min(a, b) for a, b, _ in ends]])
+    hi = np.array([[max(a, b) for a, b, _ in ends]])
+    x = [min(max(l + t * (h - l), l), h) for l, h, t in zip(lo[0], hi[0], (t for _, _, t in ends))]
+    e = np.array(rows)
+    got = integer_combinations(lo, hi, e)
+    for j, row in enumerate(rows):
+        exact = sum(Fraction(int(c)) * Fraction(float(v)) for c, v in zip(row, x))
+        assert (got.lo[0, j] == -np.inf or Fraction(float(got.lo[0, j])) <= exact)
+        assert (got.hi[0, j] == np.inf or exact <= Fraction(float(got.hi[0, j])))
+
+
+def test_integer_combinations_of_unbounded_or_nan_ends_are_the_whole_line():
+    lo = np.array([[-np.inf, 0.0, 1.0], [np.nan, 0.0, 1.0], [0.0, 0.0, 1.0]])
+    hi = np.array([[1.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 0.0, 1.0]])
+    got = integer_combinations(lo, hi, np.array([[1, 0, 0], [0, 0, 2]]))
+    assert got.lo[:2, 0].tolist() == [-np.inf, -np.inf] and got.hi[:2, 0].tolist() == [np.inf, np.inf]
+    # a row whose unbounded column has weight 0 is unbounded too (0 * inf is NaN, not 0): never a finite guess
+    assert got.lo[:2, 1].tolist() == [-np.inf, -np.inf]
+    assert np.isfinite(got.lo[2]).all() and got.lo[2, 1] <= 2.0 <= got.hi[2, 1]
 
 
 def test_intersect_of_disjoint_enclosures_is_refused():

@@ -366,7 +366,11 @@ def certainly_negative(x: Interval) -> np.ndarray:
 
 def sign_label(x: Interval) -> np.ndarray:
     """int8 array: 1 certainly positive, -1 certainly negative, 0 undecided."""
-    return np.where(x.lo > 0, 1, np.where(x.hi < 0, -1, 0)).astype(np.int8)
+    # booleans read as 0/1 bytes: a subtraction instead of two nested selections (several times faster); lo > 0
+    # wins where both hold, as it always did (an empty [lo, hi], e.g. a root range cut to nothing, reads +1)
+    pos = np.asarray(x.lo > 0)
+    neg = np.asarray(x.hi < 0) > pos
+    return np.asarray(np.subtract(pos.view(np.int8), neg.view(np.int8)))  # 0-d stays an array, as before
 
 
 def integer_combinations(lo: np.ndarray, hi: np.ndarray, e: np.ndarray) -> Interval:
@@ -375,9 +379,22 @@ def integer_combinations(lo: np.ndarray, hi: np.ndarray, e: np.ndarray) -> Inter
     5 u times the sum of their magnitudes, and the margin taken is 2**-50 = 8 u times it
     (proofs/lemma-line-misses-circle.md, Enclosures)."""
     pos, neg = np.maximum(e, 0).T.astype(np.float64), np.minimum(e, 0).T.astype(np.float64)
+    magnitude = np.maximum(np.abs(lo), np.abs(hi))
+    # the same floats as c_lo = lo @ pos + hi @ neg - margin (and c_hi), computed in place: the (m, c) arrays are
+    # the cost, the (m, k) inputs are small
     with np.errstate(invalid="ignore"):
-        c_lo, c_hi = lo @ pos + hi @ neg, hi @ pos + lo @ neg
-        margin = (np.maximum(np.abs(lo), np.abs(hi)) @ np.abs(e).T.astype(np.float64)) * 2.0**-50 + 2.0**-1000
-        c_lo, c_hi = c_lo - margin, c_hi + margin
-    bad = ~(np.isfinite(c_lo) & np.isfinite(c_hi))
-    return Interval(np.where(bad, -np.inf, c_lo), np.where(bad, np.inf, c_hi))
+        margin = magnitude @ np.abs(e).T.astype(np.float64)
+        margin *= 2.0**-50
+        margin += 2.0**-1000
+        c_lo = lo @ pos
+        c_lo += hi @ neg
+        c_lo -= margin
+        c_hi = hi @ pos
+        c_hi += lo @ neg
+        c_hi += margin
+    # inputs below 2**1000 in magnitude (no inf, no NaN: NaN fails the comparison) give sums of at most six terms
+    # of at most 2**1001, so finite ends: the check on the small inputs spares two passes over the large outputs
+    if magnitude.size and not magnitude.max() < 2.0**1000:
+        bad = ~(np.isfinite(c_lo) & np.isfinite(c_hi))
+        c_lo[bad], c_hi[bad] = -np.inf, np.inf
+    return Interval(c_lo, c_hi)
