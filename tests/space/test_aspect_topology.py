@@ -40,6 +40,21 @@ def test_the_paper_has_exactly_two_aspects(aspect_topology):
     assert (c.found, c.lower, c.upper, c.exact, c.status) == (2, 2, 2, True, Status.CERTIFIED)
 
 
+def test_a_process_proves_a_geometrys_covers_once_and_no_caller_can_change_them(aspect_topology, paper_geometry):
+    """prove_aspects keeps its result per geometry: a later analysis gets the same covers, not a new proof, and
+    an attempt to write into them fails instead of changing what the other analyses read."""
+    again = prove_aspects(paper_geometry)
+    assert again is prove_aspects(paper_geometry) and again.upper == 2
+    for cover in again.covers:
+        for a in (cover.level, cover.ijk, cover.kind, cover.direction, cover.rank):
+            with pytest.raises(ValueError):
+                a[0] = a[0]
+    # only an equal geometry shares the proof: the same numbers under another name are proved again (about 5 s)
+    from dataclasses import replace
+    other = replace(paper_geometry, name="a copy under another name")
+    assert prove_aspects(other) is not again
+
+
 def test_each_cover_tiles_the_domain(aspect_topology):
     """Integer volumes add up to the domain and no two boxes overlap (the checker's rule, in numpy)."""
     for cover in aspect_topology.covers:

@@ -47,6 +47,7 @@ re-proves every box of it in arb.  Cost on the paper's manipulator: about 1 s pe
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 
@@ -332,5 +333,25 @@ def cover_aspect(geometry: Geometry, sign: int, start_depth: int = 9, max_depth:
 
 
 def prove_aspects(geometry: Geometry, start_depth: int = 9, max_depth: int = 12) -> AspectTopology:
-    """Covers of WA1 (det A > 0) and WA2 (det A < 0); :attr:`AspectTopology.upper` is the proved bound."""
-    return AspectTopology(tuple(cover_aspect(geometry, s, start_depth, max_depth) for s in (1, -1)))
+    """Covers of WA1 (det A > 0) and WA2 (det A < 0); :attr:`AspectTopology.upper` is the proved bound.
+
+    The covers depend on nothing but the arguments, whatever the depth of the analysis that asks, so a process
+    proves them once per geometry (about 5 s on the paper's manipulator; the last four geometries are kept) and
+    hands the same result to later analyses.  Its arrays are read-only, so no caller can change what the others
+    read; ``seconds`` stays the time the proof took."""
+    try:
+        return _proved_aspects(geometry, start_depth, max_depth)
+    except TypeError:  # an unhashable geometry (not one of the package's frozen ones): proved without the memo
+        return _prove(geometry, start_depth, max_depth)
+
+
+def _prove(geometry: Geometry, start_depth: int, max_depth: int) -> AspectTopology:
+    topology = AspectTopology(tuple(cover_aspect(geometry, s, start_depth, max_depth) for s in (1, -1)))
+    for cover in topology.covers:
+        for a in (cover.domain, cover.level, cover.ijk, cover.kind, cover.direction, cover.rank, cover.weights):
+            if isinstance(a, np.ndarray):
+                a.setflags(write=False)
+    return topology
+
+
+_proved_aspects = functools.lru_cache(maxsize=4)(_prove)
