@@ -339,19 +339,14 @@ def prove_aspects(geometry: Geometry, start_depth: int = 9, max_depth: int = 12)
     proves them once per geometry (about 5 s on the paper's manipulator; the last four geometries are kept) and
     hands the same result to later analyses.  Its arrays are read-only, so no caller can change what the others
     read; ``seconds`` stays the time the proof took."""
-    try:
-        return _proved_aspects(geometry, start_depth, max_depth)
-    except TypeError:  # an unhashable geometry (not one of the package's frozen ones): proved without the memo
-        return _prove(geometry, start_depth, max_depth)
+    return _proved_aspects(geometry, start_depth, max_depth)
 
 
-def _prove(geometry: Geometry, start_depth: int, max_depth: int) -> AspectTopology:
+@functools.lru_cache(maxsize=4)  # keyed by the frozen (hashable) Geometry and the depths
+def _proved_aspects(geometry: Geometry, start_depth: int, max_depth: int) -> AspectTopology:
     topology = AspectTopology(tuple(cover_aspect(geometry, s, start_depth, max_depth) for s in (1, -1)))
     for cover in topology.covers:
         for a in (cover.domain, cover.level, cover.ijk, cover.kind, cover.direction, cover.rank, cover.weights):
             if isinstance(a, np.ndarray):
                 a.setflags(write=False)
     return topology
-
-
-_proved_aspects = functools.lru_cache(maxsize=4)(_prove)
