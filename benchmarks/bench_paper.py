@@ -5,7 +5,7 @@ joint-paving process and workers; each is counted apart, as the operating system
 time of all of them, the stage times the run wrote into ``summary.json``, and the targets of
 issue 14 (the whole paper run in 120 s and 4 GiB on two cores) beside them.
 
-    python benchmarks/bench_paper.py [--out DIR] [--keep]
+    python benchmarks/bench_paper.py [--out DIR] [--keep] [--retraction]
 
 The run has two processes busy for most of its length (the joint paving beside the regions), so
 its wall time follows its CPU time: about (CPU of the joint process) / 2 + (work after the join).
@@ -46,11 +46,14 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", help="output folder (default: a temporary one)")
     ap.add_argument("--keep", action="store_true", help="keep the temporary output folder")
+    ap.add_argument("--retraction", action="store_true",
+                    help="run `intervalkin paper --retraction` (the open layer's retraction, off by default)")
     args = ap.parse_args()
     scratch = Path(tempfile.mkdtemp(prefix="bench-paper-")) if args.out is None else None
     out = Path(args.out) if args.out else scratch / "paper"
     exe = [sys.executable, "-m", "intervalkin"]
-    wall, cpu, gib, code = _timed(exe + ["paper", "--out", str(out), "--force", "--quiet"])
+    wall, cpu, gib, code = _timed(exe + ["paper", "--out", str(out), "--force", "--quiet"]
+                                  + (["--retraction"] if args.retraction else []))
     if code != 0:
         sys.exit(f"intervalkin paper failed (exit {code})")
     v_wall, v_cpu, _, v_code = _timed(exe + ["verify", str(out)])

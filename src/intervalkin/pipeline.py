@@ -330,8 +330,8 @@ def pave_joint_space(geometry: Geometry | None = None, singular_depth: int = DEF
 
 
 def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progress: ProgressCallback | None = None,
-            refine_to: int | None = None, while_waiting: Callable[[RegionAnalysis, JointPaving], None] | None = None
-            ) -> Analysis:
+            refine_to: int | None = None, while_waiting: Callable[[RegionAnalysis, JointPaving], None] | None = None,
+            retract: bool = False) -> Analysis:
     """Run the chain geometry -> singular layer -> joint cells -> regions -> uniqueness domains.
 
     Parameters
@@ -344,6 +344,10 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
         pave the regions one level deeper, up to this depth (only undecided boxes are split).
     while_waiting : work needing the regions and the joint enclosure, not the joint cells (the chain commands'
         pavings and figures, the paper run's trajectories), done while the joint paving runs in its second process.
+    retract : also retract the joint paving's open layer towards its cells (``cells.retraction``, reported under
+        ``basic_regions.undecided.retraction``): the local step of an upper bound, which closes on no geometry yet.
+        Off by default: on the paper's manipulator it costs about two minutes of the joint process and proves no
+        count (:func:`~intervalkin.space.joint_topology.pave_joint_topology`).
 
     Raises :class:`~intervalkin.core.errors.InputError` on a bad depth and
     :class:`~intervalkin.core.errors.ResourceError` when the run would not fit in memory.
@@ -357,7 +361,7 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
     levels = {"model_levels": MODEL_LEVELS if full else 1, "face_levels": FACE_LEVELS if full else 0, "windows": full}
     name = (f"joint space paved directly (depth {dj - 1}, local models{', window models' if full else ''}, "
             f"{levels['model_levels']} + {levels['face_levels']} levels of local and face refinement, {JOIN_LEVELS} join levels; "
-            "closed cells, separations)")
+            f"closed cells, separations{', retraction' if retract else ''})")
     with contextlib.ExitStack() as side:
         future = None
         daemonic = multiprocessing.current_process().daemon
@@ -365,10 +369,11 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
             # the two pavings are independent: the joint one runs in a second process beside the regions
             # (not from a daemonic process, such as a Dask worker, which may not have children: in-process there)
             pool = side.enter_context(ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")))
-            future = pool.submit(pave_joint_topology, geometry, dj - 1, JOIN_LEVELS, **levels)
+            future = pool.submit(pave_joint_topology, geometry, dj - 1, JOIN_LEVELS, retract=retract, **levels)
         else:
             with stages.stage(name) as report:
-                cells, closure, separation = pave_joint_topology(geometry, dj - 1, JOIN_LEVELS, progress=report, **levels)
+                cells, closure, separation = pave_joint_topology(geometry, dj - 1, JOIN_LEVELS, progress=report,
+                                                                retract=retract, **levels)
         with stages.stage(f"workspace, aspects, characteristic surfaces, basic regions (depth {dw})") as levels:
             regions = analyse_regions(geometry, joint, dw, progress=levels)
         with stages.stage("aspects: covers proving each sign of det A connected"):

@@ -255,6 +255,47 @@ def test_the_barrier_face_budget_reaches_the_pattern_floods(monkeypatch, tmp_pat
     assert seen["pipeline"]["barrier_faces"] == 55
 
 
+def test_the_retraction_runs_only_when_asked(monkeypatch, tmp_path):
+    """--retraction goes from the command line to the analysis (each hop recorded, nothing computed there); the
+    analysis retracts the joint paving's open layer when asked and leaves it alone by default, and summary.json
+    says so by the presence of basic_regions.undecided.retraction."""
+    import intervalkin
+    import intervalkin.app.cli as cli
+    import intervalkin.app.commands as commands
+    from intervalkin.app.summary import chain_summary
+
+    seen = []
+    monkeypatch.setattr(cli, "run_analyze", lambda *a, **k: seen.append(k["retract"]) or 0)
+    for command in ("analyze", "paper"):
+        for extra in ([], ["--retraction"]):
+            assert main([command, "--depth", "4", "--out", str(tmp_path / "o"), "--quiet", *extra]) == 0
+    assert seen == [False, True, False, True]
+
+    class Stop(Exception):
+        pass
+
+    def analyse(*a, **k):
+        seen.append(k["retract"])
+        raise Stop
+
+    monkeypatch.setattr(commands, "analyse", analyse)
+    with pytest.raises(Stop):
+        commands.run_analyze(None, 4, tmp_path / "p", quiet=True, paper=True, retract=True)
+    assert seen[-1] is True
+
+    plain, retracted = intervalkin.analyse(depth=4), intervalkin.analyse(depth=4, retract=True)
+    assert plain.cells.retraction is None and retracted.cells.retraction is not None
+    assert "retraction" not in chain_summary(plain)["basic_regions"]["undecided"]
+    block = chain_summary(retracted)["basic_regions"]["undecided"]["retraction"]
+    assert block["nodes"] == block["sinks"] + block["resolved"] + block["unresolved"] and not block["closed"]
+    # the retraction changes no cell and no count
+    assert [c.signature for c in plain.cells.cells] == [c.signature for c in retracted.cells.cells]
+    for name in ("aspects", "basic_regions", "uniqueness_domains"):
+        a, b = getattr(plain.counts(), name), getattr(retracted.counts(), name)
+        assert (a.found, a.lower, a.upper, a.exact) == (b.found, b.lower, b.upper, b.exact)
+        assert {k: v for k, v in (b.undecided or {}).items() if k != "retraction"} == (a.undecided or {})
+
+
 @pytest.mark.parametrize("command", ["analyze", "paper"])
 def test_refine_to_out_of_range_is_refused_at_once(command, tmp_path, refused):
     out = tmp_path / "out"

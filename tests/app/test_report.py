@@ -177,9 +177,9 @@ def test_open_places_are_reported_with_their_reasons(folder):
     assert "By reason: cusp window 3 leaves (0.50); one pair window (slope not certified) 2 leaves (0.25)." in text
     row = next(line for line in text.splitlines() if line.startswith("| 0.750"))
     assert row.endswith("| cusp window 3, one pair window (slope not certified) 2 |")
-    assert "retraction" in folder[1]["basic_regions"]["undecided"]  # an analysis computes it
-    summary["basic_regions"]["undecided"].pop("retraction")
-    assert "Retraction towards the cells" not in "\n".join(joint_cells_passage(summary, ([10.0] * 3, [32.0] * 3)))
+    assert "retraction" not in folder[1]["basic_regions"]["undecided"]  # an analysis retracts only when asked
+    text = "\n".join(joint_cells_passage(summary, ([10.0] * 3, [32.0] * 3)))
+    assert "Retraction towards the cells" not in text and "was not retracted towards the cells (`--retraction`" in text
     summary["basic_regions"]["undecided"]["retraction"] = {
         "closed": False, "nodes": 100, "sinks": 60, "resolved": 30, "unresolved": 10, "leaves_unresolved": 7,
         "volume_unresolved": 0.5, "by_source": {"pair_pattern": {"nodes": 20, "unresolved": 4},

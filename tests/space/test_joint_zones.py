@@ -170,9 +170,10 @@ def test_no_pass_when_nothing_is_between(monkeypatch):
 @pytest.mark.parametrize("replaced", [False, True])
 def test_the_topology_s_retraction_and_separations_are_those_of_the_paving_it_returns(monkeypatch, paper_geometry,
                                                                                       plain, zoned, replaced):
-    """pave_joint_topology computes the separations beside the first paving's retraction: the retraction it returns
-    is the one of the paving it returns (made again when a zone pass replaced the first), and the separations are
-    those of the first paving when no pass ran.  The small pavings of this module stand for the topology's (the
+    """pave_joint_topology computes the separations beside the first paving's retraction when asked to retract: the
+    retraction it returns is the one of the paving it returns (made again when a zone pass replaced the first), and
+    the separations are those of the first paving when no pass ran; by default it returns the same paving and
+    separations with no retraction.  The small pavings of this module stand for the topology's (the
     plumbing is the same; the retraction's window nodes have their own tests)."""
     from intervalkin.space import joint_topology
     from intervalkin.space.joint_retraction import retract_joint_paving
@@ -182,10 +183,12 @@ def test_the_topology_s_retraction_and_separations_are_those_of_the_paving_it_re
     # no pass, or a pass that keeps a finer paving (here another paving stands for it)
     monkeypatch.setattr(joint_topology, "refine_separations",
                         lambda g, cells, sep, *a, **k: (finer, separated_cells(finer, g)) if replaced else (cells, sep))
-    cells, closure, separation = joint_topology.pave_joint_topology(paper_geometry, DEPTH, 0)
+    unretracted = joint_topology.pave_joint_topology(paper_geometry, DEPTH, 0)  # the default: no retraction
+    cells, closure, separation = joint_topology.pave_joint_topology(paper_geometry, DEPTH, 0, retract=True)
     final = finer if replaced else plain
-    assert cells.paving is final.paving
-    assert separation == separated_cells(final, paper_geometry)
+    assert cells.paving is final.paving and unretracted[0].paving is final.paving
+    assert separation == separated_cells(final, paper_geometry) == unretracted[2]
+    assert unretracted[0].retraction is None and "retraction" not in unretracted[0].open_places()
     want = retract_joint_paving(final, paper_geometry)
     got = cells.retraction
     assert got.leaf.size == want.leaf.size and np.array_equal(got.leaf, want.leaf)

@@ -144,9 +144,10 @@ def run_joint(geometry_path, depth: int, out, force: bool = False, quiet: bool =
 
 def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool = False, as_json: bool = False,
                 figures: bool = True, certificates: bool = True, paper: bool = False,
-                refine_to: int | None = None, barrier_faces: int | None = None) -> int:
+                refine_to: int | None = None, barrier_faces: int | None = None, retract: bool = False) -> int:
     """``intervalkin analyze`` (and ``paper`` when paper=True): the whole chain into one folder.
-    ``barrier_faces``: the pattern barriers' face budget (None: the default)."""
+    ``barrier_faces``: the pattern barriers' face budget (None: the default); ``retract``: also retract the joint
+    paving's open layer (:func:`~intervalkin.pipeline.analyse`)."""
     geometry = default_geometry() if paper else geometry_from_option(geometry_path)
     check_chain_depth(depth, refine_to)  # before the output folder is made
     if barrier_faces is not None:
@@ -171,7 +172,7 @@ def run_analyze(geometry_path, depth: int, out, force: bool = False, quiet: bool
 
         # with refine_to the regions may be paved again after the joint cells: then everything is written after
         a = analyse(geometry, depth, progress=st, refine_to=refine_to,
-                    while_waiting=beside if refine_to is None else None)
+                    while_waiting=beside if refine_to is None else None, retract=retract)
         summary = write_chain(a, out, figures=figures, stages=st, written=early.get("files"))
         trajs = []
         if paper:  # before the certificates, which re-check these paths

@@ -151,9 +151,11 @@ _NODES = {"clear": "clear leaves", "fold_piece": "fold pieces", "window_piece": 
 
 
 def _retraction_line(block: dict | None) -> str:
-    """One sentence: how far the open layer retracts into the cells (the local step of an upper bound)."""
+    """One sentence: how far the open layer retracts into the cells (the local step of an upper bound), or that
+    the run did not retract it (the retraction is asked for with ``--retraction``)."""
     if not block:
-        return ""
+        return ("The open layer was not retracted towards the cells (`--retraction` does it: the local step of an "
+                "upper bound, which closes on no geometry yet). ")
     left = [f"{_NODES.get(k, k)} {v['unresolved']}" for k, v in block["by_source"].items() if v["unresolved"]]
     head = (f"Retraction towards the cells (proofs/lemma-joint-retraction.md): {block['resolved']} of "
             f"{block['nodes'] - block['sinks']} nodes off the cells are ranked")

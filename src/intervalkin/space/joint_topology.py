@@ -3,8 +3,8 @@
 The cells of the direct joint paving (:mod:`intervalkin.space.joint_paving`) come with what the
 library proves about the components of the joint box minus g(S): the cells that are whole components
 (:func:`~intervalkin.space.joint_closure.closed_cells`), the cells of one signature that are different
-components (:func:`~intervalkin.space.joint_separation.separated_cells`), and how far the open layer
-retracts into the cells (:func:`~intervalkin.space.joint_retraction.retract_joint_paving`, the local step
+components (:func:`~intervalkin.space.joint_separation.separated_cells`), and, when asked, how far the open
+layer retracts into the cells (:func:`~intervalkin.space.joint_retraction.retract_joint_paving`, the local step
 of an upper bound).  They read only the paving, so the chain computes them where it paves it: in the paper run that is the second
 process, beside the regions, rather than after both.  Nothing here is written to the certificates.
 
@@ -42,20 +42,27 @@ ZONE_PASSES = 2
 ZONE_LEVELS = 4
 
 
-def pave_joint_topology(geometry: Geometry, depth: int, join_levels: int, progress=None,
+def pave_joint_topology(geometry: Geometry, depth: int, join_levels: int, progress=None, retract: bool = False,
                         **levels) -> tuple[JointSpacePaving, Closure, Separation]:
-    """(the paving of :func:`~intervalkin.space.joint_paving.pave_joint_space` with its open layer's retraction
-    into the cells, its closed cells, its separations), after the zone passes of the module docstring."""
+    """(the paving of :func:`~intervalkin.space.joint_paving.pave_joint_space`, its closed cells, its separations),
+    after the zone passes of the module docstring; with ``retract``, the paving carries its open layer's retraction
+    into the cells (``retraction``; None without).
+
+    The retraction is off by default: it proves no count on any geometry yet (no retraction closes), and on the
+    paper's paving it took 131 s of wall time on two cores, beside the separations, after a paving of 215 s, so a
+    run pays for it only when asked."""
     first = pave_joint_space(geometry, depth, join_levels, progress=progress, **levels)
-    # the separations are serial: a second process computes them while this one retracts the same paving, which
-    # stands unless a zone pass replaces it (then it is retracted again)
+    # the separations are serial and their working memory is large (about 1 GiB on the paper's paving): a short-lived
+    # second process computes them, meanwhile this one retracts the same paving when asked; the retraction stands
+    # unless a zone pass replaces the paving (then it is retracted again)
     with Beside(separated_cells, first, geometry) as side:
-        retraction = _retraction(first, geometry)
+        retraction = _retraction(first, geometry) if retract else None
         separation = side.result()
     cells, separation = refine_separations(geometry, first, separation, depth, join_levels, progress, **levels)
-    if cells is not first:
+    if retract and cells is not first:
         retraction = _retraction(cells, geometry)
-    cells = dataclasses.replace(cells, retraction=retraction)
+    if retract:
+        cells = dataclasses.replace(cells, retraction=retraction)
     return cells, closed_cells(cells, geometry), separation
 
 
