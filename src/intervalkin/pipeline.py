@@ -344,10 +344,8 @@ def analyse(geometry: Geometry | None = None, depth: int = DEFAULT_DEPTH, progre
         pave the regions one level deeper, up to this depth (only undecided boxes are split).
     while_waiting : work needing the regions and the joint enclosure, not the joint cells (the chain commands'
         pavings and figures, the paper run's trajectories), done while the joint paving runs in its second process.
-    retract : also retract the joint paving's open layer towards its cells (``cells.retraction``, reported under
-        ``basic_regions.undecided.retraction``): the local step of an upper bound, which closes on no geometry yet.
-        Off by default: on the paper's manipulator it costs about two minutes of the joint process and proves no
-        count (:func:`~intervalkin.space.joint_topology.pave_joint_topology`).
+    retract : also retract the joint paving's open layer towards its cells (``cells.retraction``); off by default,
+        since it closes on no geometry yet (:func:`~intervalkin.space.joint_topology.pave_joint_topology`).
 
     Raises :class:`~intervalkin.core.errors.InputError` on a bad depth and
     :class:`~intervalkin.core.errors.ResourceError` when the run would not fit in memory.
