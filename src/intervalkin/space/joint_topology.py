@@ -59,9 +59,9 @@ def pave_joint_topology(geometry: Geometry, depth: int, join_levels: int, progre
         retraction = _retraction(first, geometry) if retract else None
         separation = side.result()
     cells, separation = refine_separations(geometry, first, separation, depth, join_levels, progress, **levels)
-    if retract and cells is not first:
-        retraction = _retraction(cells, geometry)
     if retract:
+        if cells is not first:
+            retraction = _retraction(cells, geometry)
         cells = dataclasses.replace(cells, retraction=retraction)
     return cells, closed_cells(cells, geometry), separation
 
